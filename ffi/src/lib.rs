@@ -1,0 +1,15 @@
+//! # ampm (C ABI)
+//!
+//! Builds `libampm.a` and `libampm.so`. Every entry point is named
+//! `ampm_<op>_<2d|3d>_<f32|f64>`, checks its pointers, reads all inputs before writing,
+//! writes outputs only on success, returns an [`AmpmStatus`], and never lets a panic cross
+//! into C. Matrices are column-major: `F[i + d·j] = F_ij`, the layout of Eigen and glam.
+//! The header `include/ampm.h` is generated from this crate by cbindgen (see `tests/header.rs`).
+
+mod abi;
+pub mod kernels;
+mod kernels_impl;
+pub mod status;
+
+pub use kernels::*;
+pub use status::AmpmStatus;
