@@ -25,9 +25,12 @@
 #![deny(missing_docs)]
 
 pub mod augmented;
+pub mod batch;
 pub mod energy;
 pub mod error;
+pub mod hessian;
 pub mod mat;
+pub mod particle;
 pub mod polar;
 pub mod scalar;
 

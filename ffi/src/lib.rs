@@ -7,8 +7,11 @@
 //! The header `include/ampm.h` is generated from this crate by cbindgen (see `tests/header.rs`).
 
 mod abi;
+pub mod hessian;
 pub mod kernels;
 mod kernels_impl;
+pub mod methods;
+pub mod particle;
 pub mod status;
 
 pub use kernels::*;

@@ -1,0 +1,1 @@
+//! Structure-of-arrays batch kernels that the compiler vectorizes (issue 3).

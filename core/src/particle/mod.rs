@@ -1,0 +1,1 @@
+//! MPM particle updates of augmented MPM (issue 4).

@@ -1,0 +1,1 @@
+//! C entry points of the MPM particle updates (issue 4).

@@ -1,0 +1,1 @@
+//! Families of deformation gradients with stated contracts (issue 3).
