@@ -4,3 +4,4 @@
 
 pub mod families;
 pub mod reference;
+pub mod stability;

@@ -9,7 +9,10 @@
 //! at compile time. [`DefaultSvd`] is a closed form in 2D and one-sided Jacobi in 3D.
 
 mod closed_form_2d;
+mod higham_noferini;
+mod mcadams;
 mod one_sided_jacobi;
+mod qr_svd;
 
 pub use closed_form_2d::ClosedForm2;
 pub use one_sided_jacobi::OneSidedJacobi;

@@ -1,0 +1,1 @@
+//! Polar-only method: Higham–Noferini 2016 (dominant eigenvector of a 4×4 symmetric matrix).

@@ -1,0 +1,1 @@
+//! Error of each method × family × precision against the reference (issue 3).
