@@ -92,7 +92,7 @@ impl<M: Matrix> Kinematics<M> {
     #[inline]
     #[must_use]
     pub fn j(&self) -> M::Scalar {
-        scale_pow2_scalar(self.det_g, self.k * M::DIM as i32)
+        self.det_g.scalbn(self.k * M::DIM as i32)
     }
 
     /// `𝓑(G):Z`, unscaled.
@@ -120,12 +120,6 @@ impl<M: Matrix> Kinematics<M> {
     pub fn z_b(&self, z: &M) -> Result<M> {
         finite(scale_pow2(&self.z_b_g(z), -self.k))
     }
-}
-
-#[inline]
-fn scale_pow2_scalar<T: Real>(x: T, e: i32) -> T {
-    let h = e / 2;
-    x * T::ONE.scalbn(h) * T::ONE.scalbn(e - h)
 }
 
 #[inline]
