@@ -12,6 +12,106 @@
 #define AMPM_H
 
 #include <stddef.h>
+#include <stdint.h>
+
+/**
+ * `AmpmOptions::method`: the default of the dimension (2D closed form, 3D one-sided Jacobi).
+ */
+#define AMPM_METHOD_DEFAULT 0
+
+/**
+ * `AmpmOptions::method`: one-sided (Hestenes) Jacobi on F, 3D; `max_iterations` caps sweeps.
+ */
+#define AMPM_METHOD_ONE_SIDED_JACOBI 1
+
+/**
+ * `AmpmOptions::method`: McAdams et al. 2011 branch-free Jacobi on FᵀF, 3D; `sweeps` sweeps.
+ */
+#define AMPM_METHOD_MCADAMS 2
+
+/**
+ * `AmpmOptions::method`: Gast et al. 2016 implicit-shifted QR on F, 3D; `max_iterations`
+ * caps the QR sweeps.
+ */
+#define AMPM_METHOD_QR 3
+
+/**
+ * `AmpmOptions::method`: Higham–Noferini 2016 quaternion polar decomposition, 3D;
+ * `max_iterations` caps each Jacobi eigen-solve.
+ */
+#define AMPM_METHOD_HIGHAM_NOFERINI 4
+
+/**
+ * `AmpmOptions::method`: the 2D closed form (the only 2D method).
+ */
+#define AMPM_METHOD_CLOSED_FORM_2D 5
+
+/**
+ * Smallest accepted `AmpmOptions::sweeps` (other than 0 = default).
+ */
+#define AMPM_MCADAMS_MIN_SWEEPS 2
+
+/**
+ * Largest accepted `AmpmOptions::sweeps`.
+ */
+#define AMPM_MCADAMS_MAX_SWEEPS 8
+
+/**
+ * Largest accepted `AmpmOptions::max_iterations`.
+ */
+#define AMPM_MAX_ITERATIONS_LIMIT 1000
+
+/**
+ * Model bit of `AmpmMaterial.model`: snow plasticity of solids (Stomakhin et al. 2013).
+ */
+#define AMPM_MODEL_PLASTIC 1
+
+/**
+ * Model bit: heat transfer (temperatures are read and written).
+ */
+#define AMPM_MODEL_THERMAL 2
+
+/**
+ * Model bit: melting and freezing through the latent heat buffer (requires THERMAL).
+ */
+#define AMPM_MODEL_PHASE_CHANGE 4
+
+/**
+ * Model bit: the dilational part is left to the host's pressure solve (else it is in the
+ * explicit stress force, which needs `inv_lambda > 0`).
+ */
+#define AMPM_MODEL_PRESSURE_SOLVE 8
+
+/**
+ * Model bit: the force differential uses the PSD projection of the deviatoric Hessian, Ĉ⁺
+ * (with the dilational term, if not left to the pressure solve, added unprojected).
+ */
+#define AMPM_MODEL_PSD_HESSIAN 16
+
+/**
+ * Quadratic B-spline kernel (3 nodes per axis).
+ */
+#define AMPM_KERNEL_QUADRATIC 2
+
+/**
+ * Cubic B-spline kernel (4 nodes per axis).
+ */
+#define AMPM_KERNEL_CUBIC 3
+
+/**
+ * Collocated grid (nodes at i·h); 0 ≤ a < d selects the MAC face grid of component a.
+ */
+#define AMPM_GRID_COLLOCATED -1
+
+/**
+ * Phase code of a solid particle.
+ */
+#define AMPM_PHASE_SOLID 0
+
+/**
+ * Phase code of a liquid particle.
+ */
+#define AMPM_PHASE_LIQUID 1
 
 /**
  * Result of every `ampm_*` call. `AMPM_OK` is 0; every error has its own non-zero value.
@@ -54,9 +154,618 @@ typedef enum {
   AMPM_ERR_INTERNAL = 7,
 } AmpmStatus;
 
+/**
+ * Run-time choice of the polar/SVD method. Pass NULL for all defaults.
+ *
+ * Every field's 0 means "the default"; a field a method does not use is ignored.
+ */
+typedef struct {
+  /**
+   * One of the `AMPM_METHOD_*` values; anything else gives `AMPM_ERR_INVALID_ARGUMENT`, and
+   * so does a 3D method in a 2D call (or the 2D closed form in a 3D call).
+   */
+  uint32_t method;
+  /**
+   * Jacobi sweeps of `AMPM_METHOD_MCADAMS`: 0 (default, 4) or 2..=8.
+   */
+  uint32_t sweeps;
+  /**
+   * Iteration cap of `AMPM_METHOD_ONE_SIDED_JACOBI` (sweeps, default 12), `AMPM_METHOD_QR`
+   * (QR sweeps, default 32), `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per
+   * eigen-solve, default 16): 0 (default) or 1..=1000. Reaching it without convergence is
+   * `AMPM_ERR_NOT_CONVERGED` (QR, Higham–Noferini); one-sided Jacobi returns its last
+   * iterate.
+   */
+  uint32_t max_iterations;
+} AmpmOptions;
+
+/**
+ * Material parameters of one phase.
+ */
+typedef struct {
+  /**
+   * mu ≥ 0 (Pa) of the fixed corotated deviatoric energy; must be 0 for the liquid.
+   */
+  float mu;
+  /**
+   * 1/lambda ≥ 0 (1/Pa) of Psi_lambda = lambda/2 (J_E − 1)²; 0 is incompressible.
+   */
+  float inv_lambda;
+  /**
+   * Specific heat capacity c > 0 (J/(kg·K)), read with AMPM_MODEL_THERMAL.
+   */
+  float heat_capacity;
+  /**
+   * Conductivity kappa ≥ 0 (W/(m·K)), read with AMPM_MODEL_THERMAL.
+   */
+  float conductivity;
+} AmpmPhaseParams_f32;
+
+/**
+ * What a scene models (AMPM_MODEL_* bits) and its parameters; fields of parts that are off
+ * are not read.
+ */
+typedef struct {
+  /**
+   * OR of AMPM_MODEL_* bits; unknown bits are refused.
+   */
+  unsigned int model;
+  /**
+   * Solid phase parameters.
+   */
+  AmpmPhaseParams_f32 solid;
+  /**
+   * Liquid phase parameters (mu = 0).
+   */
+  AmpmPhaseParams_f32 liquid;
+  /**
+   * Snow critical compression theta_c in [0, 1) (AMPM_MODEL_PLASTIC).
+   */
+  float critical_compression;
+  /**
+   * Snow critical stretch theta_s ≥ 0 (AMPM_MODEL_PLASTIC).
+   */
+  float critical_stretch;
+  /**
+   * Hardening xi ≥ 0: mu = mu0 e^(xi (1 − J_P)), lambda likewise (AMPM_MODEL_PLASTIC).
+   */
+  float hardening;
+  /**
+   * FLIP fraction alpha in [0, 1] of the temperature transfer (AMPM_MODEL_THERMAL).
+   */
+  float flip;
+  /**
+   * Melting point T_m (K) (AMPM_MODEL_PHASE_CHANGE).
+   */
+  float melting_point;
+  /**
+   * Specific latent heat L ≥ 0 (J/kg); the buffer U lives in [0, L] (AMPM_MODEL_PHASE_CHANGE).
+   */
+  float latent_heat;
+} AmpmMaterial_f32;
+
+/**
+ * Single-precision material.
+ */
+typedef AmpmMaterial_f32 AmpmMaterialF32;
+
+/**
+ * Structure-of-arrays particle data (layouts in the module docs of ffi/src/particle.rs).
+ */
+typedef struct {
+  /**
+   * Positions (m, relative to the grid origin), n·d.
+   */
+  float *x;
+  /**
+   * Velocities (m/s), n·d.
+   */
+  float *v;
+  /**
+   * APIC affine matrices C_p (1/s), n·d², column-major.
+   */
+  float *affine;
+  /**
+   * Elastic deformation gradients F_E, n·d², det > 0.
+   */
+  float *f_e;
+  /**
+   * Plastic deformation gradients F_P, n·d², det > 0 (identity for purely elastic solids).
+   */
+  float *f_p;
+  /**
+   * Masses (kg), n, > 0.
+   */
+  const float *mass;
+  /**
+   * Reference volumes V0 (m³), n, > 0.
+   */
+  const float *volume0;
+  /**
+   * Temperatures (K), n; may be NULL without AMPM_MODEL_THERMAL.
+   */
+  float *temperature;
+  /**
+   * Latent buffers U (J/kg), n; may be NULL without AMPM_MODEL_PHASE_CHANGE.
+   */
+  float *latent;
+  /**
+   * Phases (AMPM_PHASE_*), n; may be NULL without AMPM_MODEL_PHASE_CHANGE (all solid).
+   */
+  unsigned char *phase;
+} AmpmParticles_f32;
+
+/**
+ * Single-precision particle arrays.
+ */
+typedef AmpmParticles_f32 AmpmParticlesF32;
+
+/**
+ * P2G outputs, per particle and stencil node (layouts in the module docs).
+ */
+typedef struct {
+  /**
+   * Base node grid index, n·d.
+   */
+  int *base;
+  /**
+   * Node weights w, n·K^d; may be NULL.
+   */
+  float *weight;
+  /**
+   * Node masses w m (kg), n·K^d.
+   */
+  float *mass;
+  /**
+   * Node APIC momenta w m (v + C (x_i − x_p)) (kg·m/s), n·K^d·d.
+   */
+  float *momentum;
+  /**
+   * Node stress forces −V0 P F_Eᵀ ∇w (N), n·K^d·d.
+   */
+  float *force;
+  /**
+   * Node heat capacities w m c (J/K), n·K^d; may be NULL (read only with THERMAL).
+   */
+  float *heat_capacity;
+  /**
+   * Node thermal energies w m c T (J), n·K^d; may be NULL (read only with THERMAL).
+   */
+  float *thermal_energy;
+  /**
+   * Node conductivity masses w m kappa (kg·W/(m·K)), n·K^d; may be NULL (written only with
+   * THERMAL): the node sum divided by the node mass is the mass-weighted conductivity.
+   */
+  float *conductivity;
+} AmpmP2gNodes_f32;
+
+/**
+ * Single-precision P2G outputs.
+ */
+typedef AmpmP2gNodes_f32 AmpmP2gNodesF32;
+
+/**
+ * Grid values gathered by the host at each particle's collocated stencil nodes.
+ */
+typedef struct {
+  /**
+   * New node velocities v_i^(n+1) (m/s), n·K^d·d.
+   */
+  const float *velocity;
+  /**
+   * New node temperatures T_i^(n+1) (K), n·K^d; required with AMPM_MODEL_THERMAL.
+   */
+  const float *temperature;
+  /**
+   * Old node temperatures T_i^n (K), n·K^d; required with AMPM_MODEL_THERMAL.
+   */
+  const float *temperature_old;
+} AmpmGridSamples_f32;
+
+/**
+ * Single-precision grid samples.
+ */
+typedef AmpmGridSamples_f32 AmpmGridSamplesF32;
+
+/**
+ * Material parameters of one phase.
+ */
+typedef struct {
+  /**
+   * mu ≥ 0 (Pa) of the fixed corotated deviatoric energy; must be 0 for the liquid.
+   */
+  double mu;
+  /**
+   * 1/lambda ≥ 0 (1/Pa) of Psi_lambda = lambda/2 (J_E − 1)²; 0 is incompressible.
+   */
+  double inv_lambda;
+  /**
+   * Specific heat capacity c > 0 (J/(kg·K)), read with AMPM_MODEL_THERMAL.
+   */
+  double heat_capacity;
+  /**
+   * Conductivity kappa ≥ 0 (W/(m·K)), read with AMPM_MODEL_THERMAL.
+   */
+  double conductivity;
+} AmpmPhaseParams_f64;
+
+/**
+ * What a scene models (AMPM_MODEL_* bits) and its parameters; fields of parts that are off
+ * are not read.
+ */
+typedef struct {
+  /**
+   * OR of AMPM_MODEL_* bits; unknown bits are refused.
+   */
+  unsigned int model;
+  /**
+   * Solid phase parameters.
+   */
+  AmpmPhaseParams_f64 solid;
+  /**
+   * Liquid phase parameters (mu = 0).
+   */
+  AmpmPhaseParams_f64 liquid;
+  /**
+   * Snow critical compression theta_c in [0, 1) (AMPM_MODEL_PLASTIC).
+   */
+  double critical_compression;
+  /**
+   * Snow critical stretch theta_s ≥ 0 (AMPM_MODEL_PLASTIC).
+   */
+  double critical_stretch;
+  /**
+   * Hardening xi ≥ 0: mu = mu0 e^(xi (1 − J_P)), lambda likewise (AMPM_MODEL_PLASTIC).
+   */
+  double hardening;
+  /**
+   * FLIP fraction alpha in [0, 1] of the temperature transfer (AMPM_MODEL_THERMAL).
+   */
+  double flip;
+  /**
+   * Melting point T_m (K) (AMPM_MODEL_PHASE_CHANGE).
+   */
+  double melting_point;
+  /**
+   * Specific latent heat L ≥ 0 (J/kg); the buffer U lives in [0, L] (AMPM_MODEL_PHASE_CHANGE).
+   */
+  double latent_heat;
+} AmpmMaterial_f64;
+
+/**
+ * Double-precision material.
+ */
+typedef AmpmMaterial_f64 AmpmMaterialF64;
+
+/**
+ * Structure-of-arrays particle data (layouts in the module docs of ffi/src/particle.rs).
+ */
+typedef struct {
+  /**
+   * Positions (m, relative to the grid origin), n·d.
+   */
+  double *x;
+  /**
+   * Velocities (m/s), n·d.
+   */
+  double *v;
+  /**
+   * APIC affine matrices C_p (1/s), n·d², column-major.
+   */
+  double *affine;
+  /**
+   * Elastic deformation gradients F_E, n·d², det > 0.
+   */
+  double *f_e;
+  /**
+   * Plastic deformation gradients F_P, n·d², det > 0 (identity for purely elastic solids).
+   */
+  double *f_p;
+  /**
+   * Masses (kg), n, > 0.
+   */
+  const double *mass;
+  /**
+   * Reference volumes V0 (m³), n, > 0.
+   */
+  const double *volume0;
+  /**
+   * Temperatures (K), n; may be NULL without AMPM_MODEL_THERMAL.
+   */
+  double *temperature;
+  /**
+   * Latent buffers U (J/kg), n; may be NULL without AMPM_MODEL_PHASE_CHANGE.
+   */
+  double *latent;
+  /**
+   * Phases (AMPM_PHASE_*), n; may be NULL without AMPM_MODEL_PHASE_CHANGE (all solid).
+   */
+  unsigned char *phase;
+} AmpmParticles_f64;
+
+/**
+ * Double-precision particle arrays.
+ */
+typedef AmpmParticles_f64 AmpmParticlesF64;
+
+/**
+ * P2G outputs, per particle and stencil node (layouts in the module docs).
+ */
+typedef struct {
+  /**
+   * Base node grid index, n·d.
+   */
+  int *base;
+  /**
+   * Node weights w, n·K^d; may be NULL.
+   */
+  double *weight;
+  /**
+   * Node masses w m (kg), n·K^d.
+   */
+  double *mass;
+  /**
+   * Node APIC momenta w m (v + C (x_i − x_p)) (kg·m/s), n·K^d·d.
+   */
+  double *momentum;
+  /**
+   * Node stress forces −V0 P F_Eᵀ ∇w (N), n·K^d·d.
+   */
+  double *force;
+  /**
+   * Node heat capacities w m c (J/K), n·K^d; may be NULL (read only with THERMAL).
+   */
+  double *heat_capacity;
+  /**
+   * Node thermal energies w m c T (J), n·K^d; may be NULL (read only with THERMAL).
+   */
+  double *thermal_energy;
+  /**
+   * Node conductivity masses w m kappa (kg·W/(m·K)), n·K^d; may be NULL (written only with
+   * THERMAL): the node sum divided by the node mass is the mass-weighted conductivity.
+   */
+  double *conductivity;
+} AmpmP2gNodes_f64;
+
+/**
+ * Double-precision P2G outputs.
+ */
+typedef AmpmP2gNodes_f64 AmpmP2gNodesF64;
+
+/**
+ * Grid values gathered by the host at each particle's collocated stencil nodes.
+ */
+typedef struct {
+  /**
+   * New node velocities v_i^(n+1) (m/s), n·K^d·d.
+   */
+  const double *velocity;
+  /**
+   * New node temperatures T_i^(n+1) (K), n·K^d; required with AMPM_MODEL_THERMAL.
+   */
+  const double *temperature;
+  /**
+   * Old node temperatures T_i^n (K), n·K^d; required with AMPM_MODEL_THERMAL.
+   */
+  const double *temperature_old;
+} AmpmGridSamples_f64;
+
+/**
+ * Double-precision grid samples.
+ */
+typedef AmpmGridSamples_f64 AmpmGridSamplesF64;
+
 #ifdef __cplusplus
 extern "C" {
 #endif // __cplusplus
+
+/**
+ * Computes Ĉ⁺:Z, the action of the Hessian of Ψ̂ (fixed corotated, a = −1/2) with its negative eigenvalues clamped to zero (Smith, de Goes, Kim 2019 eigensystem in the SVD basis of F). Use it as the (PSD) operator of a Newton/Krylov solve.
+ *
+ * `mu` ≥ 0; `f`, `z`: 2×2 column-major inputs; `out`: 2×2 output, written only on `AMPM_OK` (may alias `z` exactly).
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_2d_f32(float mu,
+                                  const float *f,
+                                  const float *z,
+                                  float *out);
+
+/**
+ * Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
+ *
+ * `mu`: n values; `f`, `z`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_batch_2d_f32(size_t n,
+                                        const float *mu,
+                                        const float *f,
+                                        const float *z,
+                                        float *out,
+                                        size_t *first_failed);
+
+/**
+ * Computes the explicit 4×4 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/2), symmetric and in general indefinite.
+ *
+ * Convention: vec(Z)[i + 2*j] = Z_ij (column-major), so vec(Ĉ:Z) = Ĉ · vec(Z); `out[p + 4*q]` = Ĉ[p][q] (column-major; Ĉ is symmetric). `mu` ≥ 0; `f`: 2×2 column-major input; `out`: 16 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_matrix_2d_f32(float mu,
+                                   const float *f,
+                                   float *out);
+
+/**
+ * Computes the explicit 4×4 PSD projection Ĉ⁺ of the Hessian of Ψ̂ (negative eigenvalues clamped to zero; the nearest PSD matrix to Ĉ in the Frobenius norm).
+ *
+ * Same convention as `ampm_chat_matrix_2d_f32`: `out[p + 4*q]` = Ĉ⁺[p][q], vec(Ĉ⁺:Z) = Ĉ⁺ · vec(Z) with vec(Z)[i + 2*j] = Z_ij. `mu` ≥ 0; `f`: 2×2 column-major input; `out`: 16 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_psd_matrix_2d_f32(float mu,
+                                       const float *f,
+                                       float *out);
+
+/**
+ * Computes Ĉ⁺:Z, the action of the Hessian of Ψ̂ (fixed corotated, a = −1/2) with its negative eigenvalues clamped to zero (Smith, de Goes, Kim 2019 eigensystem in the SVD basis of F). Use it as the (PSD) operator of a Newton/Krylov solve.
+ *
+ * `mu` ≥ 0; `f`, `z`: 2×2 column-major inputs; `out`: 2×2 output, written only on `AMPM_OK` (may alias `z` exactly).
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_2d_f64(double mu,
+                                  const double *f,
+                                  const double *z,
+                                  double *out);
+
+/**
+ * Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
+ *
+ * `mu`: n values; `f`, `z`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_batch_2d_f64(size_t n,
+                                        const double *mu,
+                                        const double *f,
+                                        const double *z,
+                                        double *out,
+                                        size_t *first_failed);
+
+/**
+ * Computes the explicit 4×4 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/2), symmetric and in general indefinite.
+ *
+ * Convention: vec(Z)[i + 2*j] = Z_ij (column-major), so vec(Ĉ:Z) = Ĉ · vec(Z); `out[p + 4*q]` = Ĉ[p][q] (column-major; Ĉ is symmetric). `mu` ≥ 0; `f`: 2×2 column-major input; `out`: 16 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_matrix_2d_f64(double mu,
+                                   const double *f,
+                                   double *out);
+
+/**
+ * Computes the explicit 4×4 PSD projection Ĉ⁺ of the Hessian of Ψ̂ (negative eigenvalues clamped to zero; the nearest PSD matrix to Ĉ in the Frobenius norm).
+ *
+ * Same convention as `ampm_chat_matrix_2d_f64`: `out[p + 4*q]` = Ĉ⁺[p][q], vec(Ĉ⁺:Z) = Ĉ⁺ · vec(Z) with vec(Z)[i + 2*j] = Z_ij. `mu` ≥ 0; `f`: 2×2 column-major input; `out`: 16 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_psd_matrix_2d_f64(double mu,
+                                       const double *f,
+                                       double *out);
+
+/**
+ * Computes Ĉ⁺:Z, the action of the Hessian of Ψ̂ (fixed corotated, a = −1/3) with its negative eigenvalues clamped to zero (Smith, de Goes, Kim 2019 eigensystem in the SVD basis of F). Use it as the (PSD) operator of a Newton/Krylov solve.
+ *
+ * `mu` ≥ 0; `f`, `z`: 3×3 column-major inputs; `out`: 3×3 output, written only on `AMPM_OK` (may alias `z` exactly).
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_3d_f32(float mu,
+                                  const float *f,
+                                  const float *z,
+                                  float *out);
+
+/**
+ * Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
+ *
+ * `mu`: n values; `f`, `z`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_batch_3d_f32(size_t n,
+                                        const float *mu,
+                                        const float *f,
+                                        const float *z,
+                                        float *out,
+                                        size_t *first_failed);
+
+/**
+ * Computes the explicit 9×9 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/3), symmetric and in general indefinite.
+ *
+ * Convention: vec(Z)[i + 3*j] = Z_ij (column-major), so vec(Ĉ:Z) = Ĉ · vec(Z); `out[p + 9*q]` = Ĉ[p][q] (column-major; Ĉ is symmetric). `mu` ≥ 0; `f`: 3×3 column-major input; `out`: 81 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_matrix_3d_f32(float mu,
+                                   const float *f,
+                                   float *out);
+
+/**
+ * Computes the explicit 9×9 PSD projection Ĉ⁺ of the Hessian of Ψ̂ (negative eigenvalues clamped to zero; the nearest PSD matrix to Ĉ in the Frobenius norm).
+ *
+ * Same convention as `ampm_chat_matrix_3d_f32`: `out[p + 9*q]` = Ĉ⁺[p][q], vec(Ĉ⁺:Z) = Ĉ⁺ · vec(Z) with vec(Z)[i + 3*j] = Z_ij. `mu` ≥ 0; `f`: 3×3 column-major input; `out`: 81 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_psd_matrix_3d_f32(float mu,
+                                       const float *f,
+                                       float *out);
+
+/**
+ * Computes Ĉ⁺:Z, the action of the Hessian of Ψ̂ (fixed corotated, a = −1/3) with its negative eigenvalues clamped to zero (Smith, de Goes, Kim 2019 eigensystem in the SVD basis of F). Use it as the (PSD) operator of a Newton/Krylov solve.
+ *
+ * `mu` ≥ 0; `f`, `z`: 3×3 column-major inputs; `out`: 3×3 output, written only on `AMPM_OK` (may alias `z` exactly).
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_3d_f64(double mu,
+                                  const double *f,
+                                  const double *z,
+                                  double *out);
+
+/**
+ * Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
+ *
+ * `mu`: n values; `f`, `z`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_z_psd_batch_3d_f64(size_t n,
+                                        const double *mu,
+                                        const double *f,
+                                        const double *z,
+                                        double *out,
+                                        size_t *first_failed);
+
+/**
+ * Computes the explicit 9×9 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/3), symmetric and in general indefinite.
+ *
+ * Convention: vec(Z)[i + 3*j] = Z_ij (column-major), so vec(Ĉ:Z) = Ĉ · vec(Z); `out[p + 9*q]` = Ĉ[p][q] (column-major; Ĉ is symmetric). `mu` ≥ 0; `f`: 3×3 column-major input; `out`: 81 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_matrix_3d_f64(double mu,
+                                   const double *f,
+                                   double *out);
+
+/**
+ * Computes the explicit 9×9 PSD projection Ĉ⁺ of the Hessian of Ψ̂ (negative eigenvalues clamped to zero; the nearest PSD matrix to Ĉ in the Frobenius norm).
+ *
+ * Same convention as `ampm_chat_matrix_3d_f64`: `out[p + 9*q]` = Ĉ⁺[p][q], vec(Ĉ⁺:Z) = Ĉ⁺ · vec(Z) with vec(Z)[i + 3*j] = Z_ij. `mu` ≥ 0; `f`: 3×3 column-major input; `out`: 81 scalars, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_chat_psd_matrix_3d_f64(double mu,
+                                       const double *f,
+                                       double *out);
 
 /**
  * Computes 𝓑(F):Z = Jᵃ(Z + a(H:Z)F), a = −1/2, H = F⁻ᵀ, the derivative of JᵃF in direction Z.
@@ -409,6 +1118,802 @@ AmpmStatus ampm_chat_z_batch_3d_f64(size_t n,
                                     const double *z,
                                     double *out,
                                     size_t *first_failed);
+
+/**
+ * Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(-1/2) F, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 2×2 column-major; `out[0]` receives Ψ̂ (J/m³), only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_energy_hat_ex_2d_f32(const AmpmOptions *opts,
+                                     float mu,
+                                     const float *f,
+                                     float *out);
+
+/**
+ * Computes Â = ∂Ψ̂/∂F (volume-preserving fixed corotated) with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 2×2 column-major; `out`: 2×2 stress (Pa), written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_ex_2d_f32(const AmpmOptions *opts,
+                               float mu,
+                               const float *f,
+                               float *out);
+
+/**
+ * Computes Ĉ:Z, the Hessian action of the volume-preserving fixed corotated energy, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`, `z`: 2×2 column-major; `out`: 2×2, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_ex_2d_f32(const AmpmOptions *opts,
+                                 float mu,
+                                 const float *f,
+                                 const float *z,
+                                 float *out);
+
+/**
+ * Computes Â for n particles, `out[i]` = Â(mu[i], F[i]), with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_batch_ex_2d_f32(const AmpmOptions *opts,
+                                     size_t n,
+                                     const float *mu,
+                                     const float *f,
+                                     float *out,
+                                     size_t *first_failed);
+
+/**
+ * Computes Ĉ:Z for n particles, `out[i]` = Ĉ(mu[i], F[i]):Z[i], with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `z`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_batch_ex_2d_f32(const AmpmOptions *opts,
+                                       size_t n,
+                                       const float *mu,
+                                       const float *f,
+                                       const float *z,
+                                       float *out,
+                                       size_t *first_failed);
+
+/**
+ * Computes the rotation-variant SVD F = U diag(σ) Vᵀ: U, V rotations (det +1), σ sorted by decreasing magnitude, only σ[1] may be negative (sign of det F).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 2×2 column-major, any finite F (det F ≤ 0 included); `u`, `v`: 2×2 outputs; `sigma`: 2 values. All written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_svd_2d_f32(const AmpmOptions *opts,
+                           const float *f,
+                           float *u,
+                           float *sigma,
+                           float *v);
+
+/**
+ * Computes the rotation-variant polar decomposition F = R S: R = U Vᵀ a rotation (det +1), S = V Σ Vᵀ symmetric (indefinite when det F < 0).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 2×2 column-major, any finite F (det F ≤ 0 included); `r`, `s`: 2×2 outputs, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_polar_2d_f32(const AmpmOptions *opts,
+                             const float *f,
+                             float *r,
+                             float *s);
+
+/**
+ * Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(-1/2) F, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 2×2 column-major; `out[0]` receives Ψ̂ (J/m³), only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_energy_hat_ex_2d_f64(const AmpmOptions *opts,
+                                     double mu,
+                                     const double *f,
+                                     double *out);
+
+/**
+ * Computes Â = ∂Ψ̂/∂F (volume-preserving fixed corotated) with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 2×2 column-major; `out`: 2×2 stress (Pa), written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_ex_2d_f64(const AmpmOptions *opts,
+                               double mu,
+                               const double *f,
+                               double *out);
+
+/**
+ * Computes Ĉ:Z, the Hessian action of the volume-preserving fixed corotated energy, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`, `z`: 2×2 column-major; `out`: 2×2, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_ex_2d_f64(const AmpmOptions *opts,
+                                 double mu,
+                                 const double *f,
+                                 const double *z,
+                                 double *out);
+
+/**
+ * Computes Â for n particles, `out[i]` = Â(mu[i], F[i]), with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_batch_ex_2d_f64(const AmpmOptions *opts,
+                                     size_t n,
+                                     const double *mu,
+                                     const double *f,
+                                     double *out,
+                                     size_t *first_failed);
+
+/**
+ * Computes Ĉ:Z for n particles, `out[i]` = Ĉ(mu[i], F[i]):Z[i], with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `z`, `out`: n 2×2 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_batch_ex_2d_f64(const AmpmOptions *opts,
+                                       size_t n,
+                                       const double *mu,
+                                       const double *f,
+                                       const double *z,
+                                       double *out,
+                                       size_t *first_failed);
+
+/**
+ * Computes the rotation-variant SVD F = U diag(σ) Vᵀ: U, V rotations (det +1), σ sorted by decreasing magnitude, only σ[1] may be negative (sign of det F).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 2×2 column-major, any finite F (det F ≤ 0 included); `u`, `v`: 2×2 outputs; `sigma`: 2 values. All written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_svd_2d_f64(const AmpmOptions *opts,
+                           const double *f,
+                           double *u,
+                           double *sigma,
+                           double *v);
+
+/**
+ * Computes the rotation-variant polar decomposition F = R S: R = U Vᵀ a rotation (det +1), S = V Σ Vᵀ symmetric (indefinite when det F < 0).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 2×2 column-major, any finite F (det F ≤ 0 included); `r`, `s`: 2×2 outputs, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_polar_2d_f64(const AmpmOptions *opts,
+                             const double *f,
+                             double *r,
+                             double *s);
+
+/**
+ * Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(-1/3) F, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 3×3 column-major; `out[0]` receives Ψ̂ (J/m³), only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_energy_hat_ex_3d_f32(const AmpmOptions *opts,
+                                     float mu,
+                                     const float *f,
+                                     float *out);
+
+/**
+ * Computes Â = ∂Ψ̂/∂F (volume-preserving fixed corotated) with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 3×3 column-major; `out`: 3×3 stress (Pa), written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_ex_3d_f32(const AmpmOptions *opts,
+                               float mu,
+                               const float *f,
+                               float *out);
+
+/**
+ * Computes Ĉ:Z, the Hessian action of the volume-preserving fixed corotated energy, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`, `z`: 3×3 column-major; `out`: 3×3, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_ex_3d_f32(const AmpmOptions *opts,
+                                 float mu,
+                                 const float *f,
+                                 const float *z,
+                                 float *out);
+
+/**
+ * Computes Â for n particles, `out[i]` = Â(mu[i], F[i]), with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_batch_ex_3d_f32(const AmpmOptions *opts,
+                                     size_t n,
+                                     const float *mu,
+                                     const float *f,
+                                     float *out,
+                                     size_t *first_failed);
+
+/**
+ * Computes Ĉ:Z for n particles, `out[i]` = Ĉ(mu[i], F[i]):Z[i], with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `z`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_batch_ex_3d_f32(const AmpmOptions *opts,
+                                       size_t n,
+                                       const float *mu,
+                                       const float *f,
+                                       const float *z,
+                                       float *out,
+                                       size_t *first_failed);
+
+/**
+ * Computes the rotation-variant SVD F = U diag(σ) Vᵀ: U, V rotations (det +1), σ sorted by decreasing magnitude, only σ[2] may be negative (sign of det F).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 3×3 column-major, any finite F (det F ≤ 0 included); `u`, `v`: 3×3 outputs; `sigma`: 3 values. All written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_svd_3d_f32(const AmpmOptions *opts,
+                           const float *f,
+                           float *u,
+                           float *sigma,
+                           float *v);
+
+/**
+ * Computes the rotation-variant polar decomposition F = R S: R = U Vᵀ a rotation (det +1), S = V Σ Vᵀ symmetric (indefinite when det F < 0).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 3×3 column-major, any finite F (det F ≤ 0 included); `r`, `s`: 3×3 outputs, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_polar_3d_f32(const AmpmOptions *opts,
+                             const float *f,
+                             float *r,
+                             float *s);
+
+/**
+ * Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(-1/3) F, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 3×3 column-major; `out[0]` receives Ψ̂ (J/m³), only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_energy_hat_ex_3d_f64(const AmpmOptions *opts,
+                                     double mu,
+                                     const double *f,
+                                     double *out);
+
+/**
+ * Computes Â = ∂Ψ̂/∂F (volume-preserving fixed corotated) with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`: 3×3 column-major; `out`: 3×3 stress (Pa), written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_ex_3d_f64(const AmpmOptions *opts,
+                               double mu,
+                               const double *f,
+                               double *out);
+
+/**
+ * Computes Ĉ:Z, the Hessian action of the volume-preserving fixed corotated energy, with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu` ≥ 0 (Pa); `f`, `z`: 3×3 column-major; `out`: 3×3, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_ex_3d_f64(const AmpmOptions *opts,
+                                 double mu,
+                                 const double *f,
+                                 const double *z,
+                                 double *out);
+
+/**
+ * Computes Â for n particles, `out[i]` = Â(mu[i], F[i]), with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_ahat_batch_ex_3d_f64(const AmpmOptions *opts,
+                                     size_t n,
+                                     const double *mu,
+                                     const double *f,
+                                     double *out,
+                                     size_t *first_failed);
+
+/**
+ * Computes Ĉ:Z for n particles, `out[i]` = Ĉ(mu[i], F[i]):Z[i], with a run-time choice of the polar method.
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `mu`: n values; `f`, `z`, `out`: n 3×3 column-major matrices, contiguous. Every valid particle is computed; a failed particle's output is untouched. Returns the first failure's status and writes its index (n if none) to `first_failed` (may be NULL). Arrays may be NULL when n = 0.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_chat_z_batch_ex_3d_f64(const AmpmOptions *opts,
+                                       size_t n,
+                                       const double *mu,
+                                       const double *f,
+                                       const double *z,
+                                       double *out,
+                                       size_t *first_failed);
+
+/**
+ * Computes the rotation-variant SVD F = U diag(σ) Vᵀ: U, V rotations (det +1), σ sorted by decreasing magnitude, only σ[2] may be negative (sign of det F).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 3×3 column-major, any finite F (det F ≤ 0 included); `u`, `v`: 3×3 outputs; `sigma`: 3 values. All written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_svd_3d_f64(const AmpmOptions *opts,
+                           const double *f,
+                           double *u,
+                           double *sigma,
+                           double *v);
+
+/**
+ * Computes the rotation-variant polar decomposition F = R S: R = U Vᵀ a rotation (det +1), S = V Σ Vᵀ symmetric (indefinite when det F < 0).
+ *
+ * `opts`: method choice, NULL for the defaults (see `AmpmOptions`); an invalid choice gives `AMPM_ERR_INVALID_ARGUMENT`. `f`: 3×3 column-major, any finite F (det F ≤ 0 included); `r`, `s`: 3×3 outputs, written only on `AMPM_OK`.
+ *
+ * # Safety
+ * `opts` is NULL or valid for one `AmpmOptions`; other non-null pointers must be valid for
+ * the sizes above.
+ */
+AmpmStatus ampm_polar_3d_f64(const AmpmOptions *opts,
+                             const double *f,
+                             double *r,
+                             double *s);
+
+/**
+ * Stencils of n particles (2D, f32): quadratic/cubic B-spline weights and gradients.
+ *
+ * `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a face axis 0..1; `h` > 0 (m);
+ * `x`: n·2 positions (m). Writes `base` (n·2 int), `weight` (n·K^d) and, if not NULL,
+ * `grad_weight` (n·K^d·2, 1/m), K^d = 9 (quadratic) or 27 (cubic), node order as in the module docs. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_stencil_2d_f32(size_t n,
+                               unsigned int kernel,
+                               int grid,
+                               float h,
+                               const float *x,
+                               int *base,
+                               float *weight,
+                               float *grad_weight,
+                               size_t *first_failed);
+
+/**
+ * P2G of n particles (2D, f32, collocated grid, APIC): node masses, momenta, stress forces
+ * −V0 P F_Eᵀ ∇w (P: augmented fixed corotated plus, unless AMPM_MODEL_PRESSURE_SOLVE, the
+ * dilational part) and, with AMPM_MODEL_THERMAL, heat capacities and thermal energies.
+ *
+ * Reads `particles` (not modified); writes `nodes` arrays (K^d = 9 (quadratic) or 27 (cubic)). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_p2g_2d_f32(size_t n,
+                           const AmpmMaterialF32 *material,
+                           unsigned int kernel,
+                           float h,
+                           const AmpmParticlesF32 *particles,
+                           const AmpmP2gNodesF32 *nodes,
+                           size_t *first_failed);
+
+/**
+ * G2P and particle update of n particles (2D, f32, step `dt` s): temperature and phase
+ * (PIC/FLIP, latent buffer), velocity and APIC affine matrix, position, F_E ← (I + dt∇v) F_E
+ * with the remedy (I + dt/2 ∇v)², halving until det > 0, then the liquid projection or snow
+ * plasticity, as the material says.
+ *
+ * `grid`: node values gathered at each particle's collocated stencil (K^d = 9 (quadratic) or 27 (cubic)). A failed
+ * particle's data is left as it was. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_g2p_update_2d_f32(size_t n,
+                                  const AmpmMaterialF32 *material,
+                                  unsigned int kernel,
+                                  float h,
+                                  float dt,
+                                  const AmpmParticlesF32 *particles,
+                                  const AmpmGridSamplesF32 *grid,
+                                  size_t *first_failed);
+
+/**
+ * Force differentials of n particles (2D, f32) for an implicit solve: with node
+ * displacements `du` (m, n·K^d·2), δF_E = (Σ_j du_j ∇w_jᵀ) F_E and
+ * `df` = −V0 (Ĉ:δF_E + δP_lambda) F_Eᵀ ∇w_i (N, n·K^d·2); δP_lambda only without
+ * AMPM_MODEL_PRESSURE_SOLVE. K^d = 9 (quadratic) or 27 (cubic). Particles are not modified. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_force_differential_2d_f32(size_t n,
+                                          const AmpmMaterialF32 *material,
+                                          unsigned int kernel,
+                                          float h,
+                                          const AmpmParticlesF32 *particles,
+                                          const float *du,
+                                          float *df,
+                                          size_t *first_failed);
+
+/**
+ * Pressures and pressure-solve coefficients of n particles (2D, f32):
+ * `pressure[p]` = −lambda (J_E − 1)/J_P (Pa; needs inv_lambda > 0) and
+ * `coefficient[p]` = J_P inv_lambda/(dt J_E) (1/(Pa·s); 0 when incompressible), with the
+ * hardened lambda. Either output may be NULL (not computed). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for n scalars.
+ */
+AmpmStatus ampm_pressure_2d_f32(size_t n,
+                                const AmpmMaterialF32 *material,
+                                float dt,
+                                const AmpmParticlesF32 *particles,
+                                float *pressure,
+                                float *coefficient,
+                                size_t *first_failed);
+
+/**
+ * Stencils of n particles (2D, f64): quadratic/cubic B-spline weights and gradients.
+ *
+ * `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a face axis 0..1; `h` > 0 (m);
+ * `x`: n·2 positions (m). Writes `base` (n·2 int), `weight` (n·K^d) and, if not NULL,
+ * `grad_weight` (n·K^d·2, 1/m), K^d = 9 (quadratic) or 27 (cubic), node order as in the module docs. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_stencil_2d_f64(size_t n,
+                               unsigned int kernel,
+                               int grid,
+                               double h,
+                               const double *x,
+                               int *base,
+                               double *weight,
+                               double *grad_weight,
+                               size_t *first_failed);
+
+/**
+ * P2G of n particles (2D, f64, collocated grid, APIC): node masses, momenta, stress forces
+ * −V0 P F_Eᵀ ∇w (P: augmented fixed corotated plus, unless AMPM_MODEL_PRESSURE_SOLVE, the
+ * dilational part) and, with AMPM_MODEL_THERMAL, heat capacities and thermal energies.
+ *
+ * Reads `particles` (not modified); writes `nodes` arrays (K^d = 9 (quadratic) or 27 (cubic)). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_p2g_2d_f64(size_t n,
+                           const AmpmMaterialF64 *material,
+                           unsigned int kernel,
+                           double h,
+                           const AmpmParticlesF64 *particles,
+                           const AmpmP2gNodesF64 *nodes,
+                           size_t *first_failed);
+
+/**
+ * G2P and particle update of n particles (2D, f64, step `dt` s): temperature and phase
+ * (PIC/FLIP, latent buffer), velocity and APIC affine matrix, position, F_E ← (I + dt∇v) F_E
+ * with the remedy (I + dt/2 ∇v)², halving until det > 0, then the liquid projection or snow
+ * plasticity, as the material says.
+ *
+ * `grid`: node values gathered at each particle's collocated stencil (K^d = 9 (quadratic) or 27 (cubic)). A failed
+ * particle's data is left as it was. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_g2p_update_2d_f64(size_t n,
+                                  const AmpmMaterialF64 *material,
+                                  unsigned int kernel,
+                                  double h,
+                                  double dt,
+                                  const AmpmParticlesF64 *particles,
+                                  const AmpmGridSamplesF64 *grid,
+                                  size_t *first_failed);
+
+/**
+ * Force differentials of n particles (2D, f64) for an implicit solve: with node
+ * displacements `du` (m, n·K^d·2), δF_E = (Σ_j du_j ∇w_jᵀ) F_E and
+ * `df` = −V0 (Ĉ:δF_E + δP_lambda) F_Eᵀ ∇w_i (N, n·K^d·2); δP_lambda only without
+ * AMPM_MODEL_PRESSURE_SOLVE. K^d = 9 (quadratic) or 27 (cubic). Particles are not modified. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_force_differential_2d_f64(size_t n,
+                                          const AmpmMaterialF64 *material,
+                                          unsigned int kernel,
+                                          double h,
+                                          const AmpmParticlesF64 *particles,
+                                          const double *du,
+                                          double *df,
+                                          size_t *first_failed);
+
+/**
+ * Pressures and pressure-solve coefficients of n particles (2D, f64):
+ * `pressure[p]` = −lambda (J_E − 1)/J_P (Pa; needs inv_lambda > 0) and
+ * `coefficient[p]` = J_P inv_lambda/(dt J_E) (1/(Pa·s); 0 when incompressible), with the
+ * hardened lambda. Either output may be NULL (not computed). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for n scalars.
+ */
+AmpmStatus ampm_pressure_2d_f64(size_t n,
+                                const AmpmMaterialF64 *material,
+                                double dt,
+                                const AmpmParticlesF64 *particles,
+                                double *pressure,
+                                double *coefficient,
+                                size_t *first_failed);
+
+/**
+ * Stencils of n particles (3D, f32): quadratic/cubic B-spline weights and gradients.
+ *
+ * `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a face axis 0..2; `h` > 0 (m);
+ * `x`: n·3 positions (m). Writes `base` (n·3 int), `weight` (n·K^d) and, if not NULL,
+ * `grad_weight` (n·K^d·3, 1/m), K^d = 27 (quadratic) or 64 (cubic), node order as in the module docs. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_stencil_3d_f32(size_t n,
+                               unsigned int kernel,
+                               int grid,
+                               float h,
+                               const float *x,
+                               int *base,
+                               float *weight,
+                               float *grad_weight,
+                               size_t *first_failed);
+
+/**
+ * P2G of n particles (3D, f32, collocated grid, APIC): node masses, momenta, stress forces
+ * −V0 P F_Eᵀ ∇w (P: augmented fixed corotated plus, unless AMPM_MODEL_PRESSURE_SOLVE, the
+ * dilational part) and, with AMPM_MODEL_THERMAL, heat capacities and thermal energies.
+ *
+ * Reads `particles` (not modified); writes `nodes` arrays (K^d = 27 (quadratic) or 64 (cubic)). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_p2g_3d_f32(size_t n,
+                           const AmpmMaterialF32 *material,
+                           unsigned int kernel,
+                           float h,
+                           const AmpmParticlesF32 *particles,
+                           const AmpmP2gNodesF32 *nodes,
+                           size_t *first_failed);
+
+/**
+ * G2P and particle update of n particles (3D, f32, step `dt` s): temperature and phase
+ * (PIC/FLIP, latent buffer), velocity and APIC affine matrix, position, F_E ← (I + dt∇v) F_E
+ * with the remedy (I + dt/2 ∇v)², halving until det > 0, then the liquid projection or snow
+ * plasticity, as the material says.
+ *
+ * `grid`: node values gathered at each particle's collocated stencil (K^d = 27 (quadratic) or 64 (cubic)). A failed
+ * particle's data is left as it was. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_g2p_update_3d_f32(size_t n,
+                                  const AmpmMaterialF32 *material,
+                                  unsigned int kernel,
+                                  float h,
+                                  float dt,
+                                  const AmpmParticlesF32 *particles,
+                                  const AmpmGridSamplesF32 *grid,
+                                  size_t *first_failed);
+
+/**
+ * Force differentials of n particles (3D, f32) for an implicit solve: with node
+ * displacements `du` (m, n·K^d·3), δF_E = (Σ_j du_j ∇w_jᵀ) F_E and
+ * `df` = −V0 (Ĉ:δF_E + δP_lambda) F_Eᵀ ∇w_i (N, n·K^d·3); δP_lambda only without
+ * AMPM_MODEL_PRESSURE_SOLVE. K^d = 27 (quadratic) or 64 (cubic). Particles are not modified. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_force_differential_3d_f32(size_t n,
+                                          const AmpmMaterialF32 *material,
+                                          unsigned int kernel,
+                                          float h,
+                                          const AmpmParticlesF32 *particles,
+                                          const float *du,
+                                          float *df,
+                                          size_t *first_failed);
+
+/**
+ * Pressures and pressure-solve coefficients of n particles (3D, f32):
+ * `pressure[p]` = −lambda (J_E − 1)/J_P (Pa; needs inv_lambda > 0) and
+ * `coefficient[p]` = J_P inv_lambda/(dt J_E) (1/(Pa·s); 0 when incompressible), with the
+ * hardened lambda. Either output may be NULL (not computed). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for n scalars.
+ */
+AmpmStatus ampm_pressure_3d_f32(size_t n,
+                                const AmpmMaterialF32 *material,
+                                float dt,
+                                const AmpmParticlesF32 *particles,
+                                float *pressure,
+                                float *coefficient,
+                                size_t *first_failed);
+
+/**
+ * Stencils of n particles (3D, f64): quadratic/cubic B-spline weights and gradients.
+ *
+ * `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a face axis 0..2; `h` > 0 (m);
+ * `x`: n·3 positions (m). Writes `base` (n·3 int), `weight` (n·K^d) and, if not NULL,
+ * `grad_weight` (n·K^d·3, 1/m), K^d = 27 (quadratic) or 64 (cubic), node order as in the module docs. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_stencil_3d_f64(size_t n,
+                               unsigned int kernel,
+                               int grid,
+                               double h,
+                               const double *x,
+                               int *base,
+                               double *weight,
+                               double *grad_weight,
+                               size_t *first_failed);
+
+/**
+ * P2G of n particles (3D, f64, collocated grid, APIC): node masses, momenta, stress forces
+ * −V0 P F_Eᵀ ∇w (P: augmented fixed corotated plus, unless AMPM_MODEL_PRESSURE_SOLVE, the
+ * dilational part) and, with AMPM_MODEL_THERMAL, heat capacities and thermal energies.
+ *
+ * Reads `particles` (not modified); writes `nodes` arrays (K^d = 27 (quadratic) or 64 (cubic)). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_p2g_3d_f64(size_t n,
+                           const AmpmMaterialF64 *material,
+                           unsigned int kernel,
+                           double h,
+                           const AmpmParticlesF64 *particles,
+                           const AmpmP2gNodesF64 *nodes,
+                           size_t *first_failed);
+
+/**
+ * G2P and particle update of n particles (3D, f64, step `dt` s): temperature and phase
+ * (PIC/FLIP, latent buffer), velocity and APIC affine matrix, position, F_E ← (I + dt∇v) F_E
+ * with the remedy (I + dt/2 ∇v)², halving until det > 0, then the liquid projection or snow
+ * plasticity, as the material says.
+ *
+ * `grid`: node values gathered at each particle's collocated stencil (K^d = 27 (quadratic) or 64 (cubic)). A failed
+ * particle's data is left as it was. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes in the struct docs.
+ */
+AmpmStatus ampm_g2p_update_3d_f64(size_t n,
+                                  const AmpmMaterialF64 *material,
+                                  unsigned int kernel,
+                                  double h,
+                                  double dt,
+                                  const AmpmParticlesF64 *particles,
+                                  const AmpmGridSamplesF64 *grid,
+                                  size_t *first_failed);
+
+/**
+ * Force differentials of n particles (3D, f64) for an implicit solve: with node
+ * displacements `du` (m, n·K^d·3), δF_E = (Σ_j du_j ∇w_jᵀ) F_E and
+ * `df` = −V0 (Ĉ:δF_E + δP_lambda) F_Eᵀ ∇w_i (N, n·K^d·3); δP_lambda only without
+ * AMPM_MODEL_PRESSURE_SOLVE. K^d = 27 (quadratic) or 64 (cubic). Particles are not modified. Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_force_differential_3d_f64(size_t n,
+                                          const AmpmMaterialF64 *material,
+                                          unsigned int kernel,
+                                          double h,
+                                          const AmpmParticlesF64 *particles,
+                                          const double *du,
+                                          double *df,
+                                          size_t *first_failed);
+
+/**
+ * Pressures and pressure-solve coefficients of n particles (3D, f64):
+ * `pressure[p]` = −lambda (J_E − 1)/J_P (Pa; needs inv_lambda > 0) and
+ * `coefficient[p]` = J_P inv_lambda/(dt J_E) (1/(Pa·s); 0 when incompressible), with the
+ * hardened lambda. Either output may be NULL (not computed). Batch contract.
+ *
+ * # Safety
+ * Non-null pointers must be valid for n scalars.
+ */
+AmpmStatus ampm_pressure_3d_f64(size_t n,
+                                const AmpmMaterialF64 *material,
+                                double dt,
+                                const AmpmParticlesF64 *particles,
+                                double *pressure,
+                                double *coefficient,
+                                size_t *first_failed);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -1,11 +1,19 @@
 //! Generic bodies of the kernel entry points (fixed corotated base energy, default method).
 
-use crate::abi::{batch, binary, check_batch, guard, read_mat, unary};
+//!
+//! The batch functions run the vectorized kernels of `ampm_core::batch` (2D: closed form;
+//! 3D: McAdams with the per-precision sweep count of `BatchKernel::SWEEPS`), dispatched at run
+//! time to an AVX2 compiled copy when the CPU has it. Their results equal, bit for
+//! bit, the scalar kernels with that method (`tests/batch.rs`); the single-particle functions
+//! keep the default method (one-sided Jacobi in 3D).
+
+use crate::abi::{binary, check_batch, guard, read_mat, unary, write_mat};
 use crate::status::AmpmStatus;
-use ampm_core::augmented::{self, Augmented};
+use ampm_core::augmented;
+use ampm_core::batch::{BatchKernel, MAX_LANES};
 use ampm_core::energy::FixedCorotated;
 use ampm_core::polar::{DefaultSvd, SvdMethod};
-use ampm_core::Matrix;
+use ampm_core::{Matrix, Real};
 use core::ptr;
 
 pub(crate) unsafe fn b_z<M: Matrix>(
@@ -71,48 +79,139 @@ where
     })
 }
 
-pub(crate) unsafe fn ahat_batch<M: Matrix>(
+/// The chunk loop of the batch functions: reads each chunk of `M::LANES` particles completely
+/// (so `out == f` or `out == z` in place is fine), runs the vectorized kernel of
+/// `ampm_core::batch`, writes the successful particles and records the first failure.
+///
+/// # Safety
+/// `mu` valid for `n` scalars; `f`, `out` (and `z` when `Some`) for `n·M::LEN` scalars.
+#[inline(always)]
+unsafe fn run_batch<M: BatchKernel>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    z: Option<*const M::Scalar>,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+) -> AmpmStatus {
+    let mut status = AmpmStatus::AMPM_OK;
+    let mut first = n;
+    let mut mub = [<M::Scalar as Real>::ZERO; MAX_LANES];
+    let mut fb = [M::zero(); MAX_LANES];
+    let mut zb = [M::zero(); MAX_LANES];
+    let mut ob = [M::zero(); MAX_LANES];
+    let mut eb = [None; MAX_LANES];
+    let lanes = M::LANES.min(MAX_LANES);
+    let mut start = 0;
+    while start < n {
+        let len = lanes.min(n - start);
+        for l in 0..len {
+            let i = start + l;
+            mub[l] = ptr::read_unaligned(mu.add(i));
+            fb[l] = read_mat::<M>(f.add(i * M::LEN));
+            if let Some(z) = z {
+                zb[l] = read_mat::<M>(z.add(i * M::LEN));
+            }
+        }
+        match z {
+            None => M::ahat_chunk(&mub[..len], &fb[..len], &mut ob[..len], &mut eb[..len]),
+            Some(_) => M::chat_z_chunk(
+                &mub[..len],
+                &fb[..len],
+                &zb[..len],
+                &mut ob[..len],
+                &mut eb[..len],
+            ),
+        }
+        for l in 0..len {
+            match eb[l] {
+                None => write_mat(out.add((start + l) * M::LEN), &ob[l]),
+                Some(e) => {
+                    if first == n {
+                        first = start + l;
+                        status = e.into();
+                    }
+                }
+            }
+        }
+        start += len;
+    }
+    if !first_failed.is_null() {
+        *first_failed = first;
+    }
+    status
+}
+
+/// [`run_batch`] compiled for AVX2 (the same source: LLVM widens the lane loops to 256 bits).
+///
+/// # Safety
+/// As [`run_batch`], and the CPU must support AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn run_batch_avx2<M: BatchKernel>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    z: Option<*const M::Scalar>,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+) -> AmpmStatus {
+    run_batch::<M>(n, mu, f, z, out, first_failed)
+}
+
+/// Runtime dispatch to the AVX2 copy of [`run_batch`] when the CPU supports it. All copies
+/// give identical bits (IEEE operations only, no FMA contraction in Rust).
+///
+/// # Safety
+/// As [`run_batch`].
+#[inline]
+unsafe fn dispatch<M: BatchKernel>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    z: Option<*const M::Scalar>,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+) -> AmpmStatus {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the feature was detected at run time.
+            return run_batch_avx2::<M>(n, mu, f, z, out, first_failed);
+        }
+    }
+    run_batch::<M>(n, mu, f, z, out, first_failed)
+}
+
+pub(crate) unsafe fn ahat_batch<M: BatchKernel>(
     n: usize,
     mu: *const M::Scalar,
     f: *const M::Scalar,
     out: *mut M::Scalar,
     first_failed: *mut usize,
-) -> AmpmStatus
-where
-    DefaultSvd: SvdMethod<M>,
-{
+) -> AmpmStatus {
     guard(|| {
         let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), out.is_null()]);
         if st != AmpmStatus::AMPM_OK {
             return st;
         }
-        batch::<M>(n, out, first_failed, |i| {
-            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
-            augmented::ahat(&e, &read_mat::<M>(f.add(i * M::LEN)))
-        })
+        dispatch::<M>(n, mu, f, None, out, first_failed)
     })
 }
 
-pub(crate) unsafe fn chat_z_batch<M: Matrix>(
+pub(crate) unsafe fn chat_z_batch<M: BatchKernel>(
     n: usize,
     mu: *const M::Scalar,
     f: *const M::Scalar,
     z: *const M::Scalar,
     out: *mut M::Scalar,
     first_failed: *mut usize,
-) -> AmpmStatus
-where
-    DefaultSvd: SvdMethod<M>,
-{
+) -> AmpmStatus {
     guard(|| {
         let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
         if st != AmpmStatus::AMPM_OK {
             return st;
         }
-        batch::<M>(n, out, first_failed, |i| {
-            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
-            let zi = read_mat::<M>(z.add(i * M::LEN));
-            Augmented::new(&e, &read_mat::<M>(f.add(i * M::LEN)))?.chat_z(&zi)
-        })
+        dispatch::<M>(n, mu, f, Some(z), out, first_failed)
     })
 }

@@ -5,3 +5,4 @@
 pub mod families;
 pub mod reference;
 pub mod stability;
+pub mod workload;

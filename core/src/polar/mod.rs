@@ -7,6 +7,18 @@
 //!
 //! Methods implement [`SvdMethod`]; the kernels are generic over it, so the choice is made
 //! at compile time. [`DefaultSvd`] is a closed form in 2D and one-sided Jacobi in 3D.
+//!
+//! The methods (the C ABI selects among the same ones at run time, `ffi/src/methods.rs`):
+//!
+//! | method | dim | idea | accuracy (`κ = 2σ₀/min(σᵢ+σⱼ)`) |
+//! |---|---|---|---|
+//! | [`ClosedForm2`] | 2D | closed form, `R` from normalised `(F₀₀+F₁₁, F₁₀−F₀₁)` | `O(ε κ)` |
+//! | [`OneSidedJacobi`] | 3D | Hestenes one-sided Jacobi on `F` | `O(ε κ)`, small `σ` to high relative accuracy |
+//! | [`McAdams`] | 3D | branch-free Jacobi on `FᵀF`, approximate Givens, fixed sweeps | `O(ε κ²)` at best; sweep-limited |
+//! | [`QrSvd`] | 3D | Gast et al. 2016 implicit-shifted QR on `F`, tolerance relative to `‖F‖` | `O(ε κ)` |
+//! | [`HighamNoferini`] | 3D | dominant eigenvector of a 4×4 symmetric matrix (quaternion), then `eig(S)` | `O(ε κ)` |
+//!
+//! The measured errors per family of `F` are in `docs/stability-table.md` (`ampm-report`).
 
 mod closed_form_2d;
 mod higham_noferini;
@@ -15,7 +27,10 @@ mod one_sided_jacobi;
 mod qr_svd;
 
 pub use closed_form_2d::ClosedForm2;
+pub use higham_noferini::HighamNoferini;
+pub use mcadams::McAdams;
 pub use one_sided_jacobi::OneSidedJacobi;
+pub use qr_svd::QrSvd;
 
 use crate::error::Result;
 use crate::mat::{Mat, Matrix};
@@ -119,12 +134,18 @@ pub fn scale_exponent<M: Matrix>(f: &M) -> i32 {
     f.max_abs().exponent()
 }
 
-/// `f · 2ᵉ`, exact, in two steps so that `2ᵉ` itself never overflows (|e| up to ~2000).
+/// `f · 2ᵉ`, rounded once (exact unless an entry over- or underflows), for any `e`.
+///
+/// When `2ᵉ` is a normal number one multiplication per entry is exact; otherwise (|e| beyond
+/// the exponent range, e.g. the `2⁻²ᵏ` of `Ĉ` for a subnormal `F`) each entry goes through
+/// `scalbn`, so `0 · 2ᵉ = 0` and no `0 · inf = NaN` can appear.
 #[inline]
 #[must_use]
 pub fn scale_pow2<M: Matrix>(f: &M, e: i32) -> M {
-    let h = e / 2;
-    let p1 = M::Scalar::ONE.scalbn(h);
-    let p2 = M::Scalar::ONE.scalbn(e - h);
-    f.map(|x| x * p1 * p2)
+    let p = M::Scalar::ONE.scalbn(e);
+    if p >= M::Scalar::MIN_POSITIVE && p.is_finite() {
+        f.map(|x| x * p)
+    } else {
+        f.map(|x| x.scalbn(e))
+    }
 }

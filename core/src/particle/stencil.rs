@@ -1,0 +1,284 @@
+//! Interpolation stencils: quadratic and cubic B-spline weights and weight gradients of one
+//! particle, on a collocated grid or on one MAC face grid.
+//!
+//! **Grids.** The host's grid has spacing `h` (m) and its origin at position 0: the host
+//! passes particle positions relative to its grid origin. Cells are `[i h, (i+1) h]` per axis.
+//! - [`Grid::Collocated`]: nodes at `x_i = i h` (cell corners), all velocity components there.
+//! - [`Grid::Face`]`(a)`: the grid of the `a`-th velocity component of a MAC grid, nodes at
+//!   `i h` along axis `a` and at cell centres `(j + ½) h` along every other axis.
+//!
+//! **Node indexing.** A stencil covers `K^d` nodes, `K = 3` (quadratic) or `4` (cubic): the
+//! grid nodes `base + o`, `o ∈ {0, …, K−1}^d`. Node `r ∈ [0, K^d)` has offsets
+//! `o_a = (r / K^a) mod K` (axis 0 fastest), so `r = Σ_a o_a K^a`. Every per-node array of the
+//! particle module (Rust slices and C arrays) is in this order.
+//!
+//! **Kernels.** Tensor products `w_i = Π_a N((x_p,a − x_i,a)/h)` of the centred B-splines
+//! (Steffen, Kirby, Berzins 2008; the MPM choice of Stomakhin et al. 2013 §5 and 2014 §7):
+//! - quadratic: `N(d) = ¾ − d²` for `|d| < ½`, `½(³⁄₂ − |d|)²` for `½ ≤ |d| < ³⁄₂`, else 0;
+//! - cubic: `N(d) = ½|d|³ − d² + ⅔` for `|d| < 1`, `(2 − |d|)³/6` for `1 ≤ |d| < 2`, else 0.
+//!
+//! `∇w_i = ∂w_i/∂x_p` (1/m), component `a` being `N'(d_a)/h · Π_{b≠a} N(d_b)`.
+//!
+//! **Precision.** The particle's position inside the stencil is kept in cell units
+//! (`fx_a = x_a/h − s_a − base_a ∈ [½, ³⁄₂)` quadratic, `[1, 2)` cubic); the fractional part
+//! `ξ − ⌊ξ⌋` is exact in binary floating point, so the weights do not lose accuracy far from
+//! the origin, and `x_i − x_p = (o − fx) h` is formed without cancellation.
+
+use crate::error::{Error, Result};
+use crate::scalar::Real;
+
+/// The B-spline interpolation kernel.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Kernel {
+    /// Quadratic B-spline, 3 nodes per axis.
+    Quadratic,
+    /// Cubic B-spline, 4 nodes per axis.
+    Cubic,
+}
+
+impl Kernel {
+    /// Nodes per axis, `K` (3 or 4).
+    #[inline]
+    #[must_use]
+    pub const fn width(self) -> usize {
+        match self {
+            Kernel::Quadratic => 3,
+            Kernel::Cubic => 4,
+        }
+    }
+
+    /// Nodes of the stencil, `K^d`.
+    #[inline]
+    #[must_use]
+    pub const fn node_count(self, d: usize) -> usize {
+        let k = self.width();
+        if d == 2 {
+            k * k
+        } else {
+            k * k * k
+        }
+    }
+
+    /// `D_p / h²` of APIC, the kernel's second moment: `Σ_i w_i (x_i − x_p)(x_i − x_p)ᵀ =
+    /// (D_p/h²) h² I`, independent of the particle's position: ¼ (quadratic), ⅓ (cubic)
+    /// (Jiang et al. 2015, "The affine particle-in-cell method", §5.3).
+    #[inline]
+    #[must_use]
+    pub fn apic_moment<T: Real>(self) -> T {
+        match self {
+            Kernel::Quadratic => T::from_f64(0.25),
+            Kernel::Cubic => T::ONE / T::from_i32(3),
+        }
+    }
+
+    /// `N(d)`, the 1D B-spline at signed distance `d` (in cells).
+    #[inline]
+    #[must_use]
+    pub fn n<T: Real>(self, d: T) -> T {
+        self.n_dn(d).0
+    }
+
+    /// `(N(d), N'(d))`: the 1D B-spline and its derivative at signed distance `d` (cells).
+    #[inline]
+    #[must_use]
+    pub fn n_dn<T: Real>(self, d: T) -> (T, T) {
+        let ad = d.abs();
+        let three_halves = T::from_f64(1.5);
+        match self {
+            Kernel::Quadratic => {
+                if ad < T::HALF {
+                    (T::from_f64(0.75) - d * d, -(d + d))
+                } else if ad < three_halves {
+                    let e = three_halves - ad;
+                    (T::HALF * e * e, -(e.copysign(d)))
+                } else {
+                    (T::ZERO, T::ZERO)
+                }
+            }
+            Kernel::Cubic => {
+                if ad < T::ONE {
+                    // ½|d|³ − d² + ⅔, derivative (3/2)|d|d − 2d.
+                    let n = (T::HALF * ad - T::ONE) * d * d + T::TWO / T::from_i32(3);
+                    (n, (three_halves * ad - T::TWO) * d)
+                } else if ad < T::TWO {
+                    let e = T::TWO - ad;
+                    (e * e * e / T::from_i32(6), -((T::HALF * e * e).copysign(d)))
+                } else {
+                    (T::ZERO, T::ZERO)
+                }
+            }
+        }
+    }
+}
+
+/// Which grid the stencil interpolates from (see the module docs for node positions).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Grid {
+    /// Nodes at `i h`.
+    Collocated,
+    /// The MAC face grid of velocity component `a < d`: nodes at `i h` along `a`, at
+    /// `(j + ½) h` along the other axes.
+    Face(usize),
+}
+
+/// One node of a stencil.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node<T, const D: usize> {
+    /// Integer grid index `base + o` of the node.
+    pub index: [i32; D],
+    /// Weight `w_i` (dimensionless).
+    pub weight: T,
+    /// Weight gradient `∇w_i = ∂w_i/∂x_p` (1/m).
+    pub grad: [T; D],
+    /// `x_i − x_p` (m).
+    pub dx: [T; D],
+}
+
+/// The B-spline stencil of one particle: per-axis weights, their derivatives, and the base
+/// node (see the module docs for the node order).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stencil<T, const D: usize> {
+    /// The kernel (3 or 4 nodes per axis).
+    pub kernel: Kernel,
+    /// Grid spacing `h` (m).
+    pub h: T,
+    /// Grid index of node `o = 0`.
+    pub base: [i32; D],
+    /// Particle position relative to the base node, in cells (`[½, ³⁄₂)` or `[1, 2)`).
+    pub fx: [T; D],
+    /// Per-axis weights `N(fx_a − o)`, `o < K` (unused entries 0).
+    pub w: [[T; 4]; D],
+    /// Per-axis derivatives `N'(fx_a − o)/h` (1/m).
+    pub dw: [[T; 4]; D],
+}
+
+/// Positions whose cell index does not fit comfortably in `i32` are refused.
+const MAX_CELLS: f64 = 1_073_741_824.0; // 2^30
+
+impl<T: Real, const D: usize> Stencil<T, D> {
+    /// The stencil of a particle at `x` (m, relative to the grid origin) on grid `grid` with
+    /// spacing `h` (m).
+    ///
+    /// Errors: [`Error::NonFinite`] for a NaN/inf position or spacing;
+    /// [`Error::InvalidArgument`] for `h ≤ 0`, a face axis `≥ d`, or `|x/h| ≥ 2³⁰`.
+    #[inline]
+    pub fn new(kernel: Kernel, grid: Grid, h: T, x: &[T; D]) -> Result<Self> {
+        if !h.is_finite() || x.iter().any(|c| !c.is_finite()) {
+            return Err(Error::NonFinite);
+        }
+        if h <= T::ZERO {
+            return Err(Error::InvalidArgument);
+        }
+        if let Grid::Face(a) = grid {
+            if a >= D {
+                return Err(Error::InvalidArgument);
+            }
+        }
+        let mut s = Self {
+            kernel,
+            h,
+            base: [0; D],
+            fx: [T::ZERO; D],
+            w: [[T::ZERO; 4]; D],
+            dw: [[T::ZERO; 4]; D],
+        };
+        let inv_h = T::ONE / h;
+        for a in 0..D {
+            let shift = match grid {
+                Grid::Face(f) if f != a => T::HALF,
+                _ => T::ZERO,
+            };
+            let xi = x[a] * inv_h - shift;
+            let xi64 = xi.to_f64();
+            if !xi.is_finite() || xi64.abs() >= MAX_CELLS {
+                return Err(Error::InvalidArgument);
+            }
+            let fl = libm::floor(xi64);
+            // Exact: ξ − ⌊ξ⌋ (Sterbenz for |ξ| ≥ 1, trivially below), in [0, 1).
+            let frac = xi - T::from_f64(fl);
+            let fl = fl as i32;
+            // fx: distance of the particle from the base node, in cells.
+            let (base, fx) = match kernel {
+                // Nearest node is base+1: base = ⌊ξ − ½⌋.
+                Kernel::Quadratic if frac < T::HALF => (fl - 1, frac + T::ONE),
+                Kernel::Quadratic => (fl, frac),
+                // Base = ⌊ξ⌋ − 1, two nodes on each side.
+                Kernel::Cubic => (fl - 1, frac + T::ONE),
+            };
+            s.base[a] = base;
+            s.fx[a] = fx;
+            for o in 0..kernel.width() {
+                let (n, dn) = kernel.n_dn(fx - T::from_i32(o as i32));
+                s.w[a][o] = n;
+                s.dw[a][o] = dn * inv_h;
+            }
+        }
+        Ok(s)
+    }
+
+    /// Number of nodes, `K^d`.
+    #[inline]
+    #[must_use]
+    pub fn len(&self) -> usize {
+        self.kernel.node_count(D)
+    }
+
+    /// Always false (a stencil has at least 9 nodes).
+    #[inline]
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Per-axis offsets `o` of node `r` (axis 0 fastest).
+    #[inline]
+    #[must_use]
+    pub fn offsets(&self, r: usize) -> [usize; D] {
+        let k = self.kernel.width();
+        let mut o = [0usize; D];
+        let mut q = r;
+        for oa in o.iter_mut() {
+            *oa = q % k;
+            q /= k;
+        }
+        o
+    }
+
+    /// Node `r < len()`: grid index, weight, weight gradient and `x_i − x_p`.
+    #[inline]
+    #[must_use]
+    pub fn node(&self, r: usize) -> Node<T, D> {
+        let o = self.offsets(r);
+        let mut index = [0i32; D];
+        let mut dx = [T::ZERO; D];
+        let mut weight = T::ONE;
+        for a in 0..D {
+            index[a] = self.base[a] + o[a] as i32;
+            dx[a] = (T::from_i32(o[a] as i32) - self.fx[a]) * self.h;
+            weight *= self.w[a][o[a]];
+        }
+        let mut grad = [T::ZERO; D];
+        for (a, g) in grad.iter_mut().enumerate() {
+            let mut p = self.dw[a][o[a]];
+            for b in 0..D {
+                if b != a {
+                    p *= self.w[b][o[b]];
+                }
+            }
+            *g = p;
+        }
+        Node {
+            index,
+            weight,
+            grad,
+            dx,
+        }
+    }
+
+    /// Iterator over the nodes in stencil order.
+    #[inline]
+    #[must_use]
+    pub fn nodes(&self) -> impl Iterator<Item = Node<T, D>> + '_ {
+        (0..self.len()).map(move |r| self.node(r))
+    }
+}

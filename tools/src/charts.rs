@@ -1,0 +1,365 @@
+//! The charts of issue 3, drawn with plotters: the speed–accuracy chart (SVG and PNG) and the
+//! stability chart (SVG).
+//!
+//! Text: plotters' `ab_glyph` backend with a TrueType font read at run time and registered as
+//! "sans-serif" (no system library at build time). The font is DejaVu Sans from Debian's
+//! `fonts-dejavu-core`; `AMPM_FONT=/path/to/font.ttf` overrides it.
+
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use plotters::style::{register_font, FontStyle};
+use std::path::Path;
+
+/// Where the font is looked for, in order (after `$AMPM_FONT`).
+const FONT_CANDIDATES: [&str; 3] = [
+    "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf",
+    "/usr/share/fonts/TTF/DejaVuSans.ttf",
+    "/usr/share/fonts/dejavu/DejaVuSans.ttf",
+];
+
+/// The font family the charts use.
+const FONT: &str = "sans-serif";
+
+/// Reads and registers the charts' font; says what to install when none is found.
+pub fn init_font() -> Result<String, String> {
+    let env = std::env::var("AMPM_FONT").ok();
+    let path = env
+        .iter()
+        .map(String::as_str)
+        .chain(FONT_CANDIDATES)
+        .find(|p| Path::new(p).is_file())
+        .ok_or_else(|| {
+            format!(
+                "no TrueType font found (tried $AMPM_FONT and {}): install Debian's \
+                 fonts-dejavu-core (apt-get install fonts-dejavu-core) or set AMPM_FONT",
+                FONT_CANDIDATES.join(", ")
+            )
+        })?;
+    let bytes = std::fs::read(path).map_err(|e| format!("reading {path}: {e}"))?;
+    // plotters keeps the font for the whole process: leak the one buffer on purpose.
+    let bytes: &'static [u8] = Box::leak(bytes.into_boxed_slice());
+    register_font(FONT, FontStyle::Normal, bytes)
+        .map_err(|_| format!("{path} is not a usable TrueType/OpenType font"))?;
+    Ok(path.to_string())
+}
+
+/// A categorical palette (Tableau 10), assigned to methods in a fixed order.
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+/// Color of the `i`-th method.
+fn color(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+/// One point of the speed–accuracy chart.
+#[derive(Clone, Debug)]
+pub struct SpeedPoint {
+    /// Method family (one color and one legend entry each), e.g. "McAdams".
+    pub method: String,
+    /// Label next to the point, e.g. "McAdams 4, 3D f32".
+    pub label: String,
+    /// Precision: f32 points are triangles, f64 points circles.
+    pub is_f32: bool,
+    /// ns per particle of `Â + Ĉ:Z` with this method (filled marker).
+    pub ns_kernels: f64,
+    /// ns per particle of the SVD alone (hollow marker, same height).
+    pub ns_svd: f64,
+    /// p99 error against the double-double reference.
+    pub p99: f64,
+}
+
+/// Errors below this are drawn at this value (a log axis has no zero).
+pub const ERROR_FLOOR: f64 = 1e-18;
+
+/// A log range covering `values` with some margin, whole decades.
+fn log_range(values: impl Iterator<Item = f64>, floor: f64) -> std::ops::Range<f64> {
+    let (mut lo, mut hi) = (f64::INFINITY, 0.0f64);
+    for v in values.filter(|v| v.is_finite()) {
+        let v = v.max(floor);
+        lo = lo.min(v);
+        hi = hi.max(v);
+    }
+    if !lo.is_finite() || hi <= 0.0 {
+        return 1e-1..1e1;
+    }
+    10f64.powf(lo.log10().floor())..10f64.powf((hi.log10() + 0.01).ceil())
+}
+
+/// Tick label of a log axis: `1e-7`.
+fn sci(v: &f64) -> String {
+    format!("{v:.0e}")
+}
+
+type DrawResult = Result<(), String>;
+
+fn err<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Draws the speed–accuracy chart on `root`.
+fn draw_speed<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pts: &[SpeedPoint]) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let xr = log_range(
+        pts.iter().flat_map(|p| [p.ns_kernels, p.ns_svd]),
+        ERROR_FLOOR,
+    );
+    let yr = log_range(pts.iter().map(|p| p.p99), ERROR_FLOOR);
+    let mut chart = ChartBuilder::on(root)
+        .caption(
+            "SVD methods: cost per particle vs accuracy (Haar F, log-uniform σ in [1e-4, 1e4])",
+            (FONT, 22),
+        )
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time per particle, ns (filled: Â + Ĉ:Z, hollow: the SVD alone; ● f64, ▲ f32)")
+        .y_desc("p99 relative error of R vs double-double")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&sci)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .draw()
+        .map_err(err)?;
+
+    let mut methods: Vec<&str> = Vec::new();
+    for p in pts {
+        if !methods.contains(&p.method.as_str()) {
+            methods.push(&p.method);
+        }
+    }
+    for (mi, m) in methods.iter().enumerate() {
+        let c = color(mi);
+        let mine: Vec<&SpeedPoint> = pts.iter().filter(|p| p.method == *m).collect();
+        // The SVD alone → the full Â + Ĉ:Z, at the same error.
+        for p in &mine {
+            let y = p.p99.max(ERROR_FLOOR);
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(p.ns_svd, y), (p.ns_kernels, y)],
+                    c.mix(0.35).stroke_width(1),
+                )))
+                .map_err(err)?;
+            // Hollow marker: the colored shape with a white one inside.
+            let (outer, inner) = (c.filled(), WHITE.filled());
+            if p.is_f32 {
+                chart
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((p.ns_svd, y))
+                            + TriangleMarker::new((0, 0), 7, outer)
+                            + TriangleMarker::new((0, 0), 3, inner),
+                    ))
+                    .map_err(err)?;
+            } else {
+                chart
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((p.ns_svd, y))
+                            + Circle::new((0, 0), 5, outer)
+                            + Circle::new((0, 0), 3, inner),
+                    ))
+                    .map_err(err)?;
+            }
+        }
+        let filled = c.filled();
+        let at = |p: &SpeedPoint| (p.ns_kernels, p.p99.max(ERROR_FLOOR));
+        let f64s = chart
+            .draw_series(mine.iter().filter(|p| !p.is_f32).map(|p| {
+                EmptyElement::at(at(p))
+                    + Circle::new((0, 0), 5, filled)
+            }))
+            .map_err(err)?;
+        let f64_count = mine.iter().filter(|p| !p.is_f32).count();
+        if f64_count > 0 {
+            f64s.label(m.to_string())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 5, filled));
+        }
+        let f32s = chart
+            .draw_series(mine.iter().filter(|p| p.is_f32).map(|p| {
+                EmptyElement::at(at(p))
+                    + TriangleMarker::new((0, 0), 7, filled)
+            }))
+            .map_err(err)?;
+        if f64_count == 0 {
+            f32s.label(m.to_string())
+                .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 7, filled));
+        }
+    }
+    // Labels last, each at the first candidate offset whose box overlaps no earlier label.
+    let font: TextStyle = (FONT, 11).into();
+    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
+    for p in pts {
+        let (px, py) = chart.backend_coord(&(p.ns_kernels, p.p99.max(ERROR_FLOOR)));
+        let (w, h) = root.estimate_text_size(&p.label, &font).map_err(err)?;
+        let (w, h) = (w as i32, h as i32);
+        let candidates = [
+            (8, 2),
+            (8, -h - 2),
+            (8, h + 4),
+            (8, -2 * h - 4),
+            (8, 2 * h + 6),
+            (-w - 8, 2),
+            (-w - 8, -h - 2),
+        ];
+        let free = |x: i32, y: i32| {
+            placed
+                .iter()
+                .all(|&(a, b, c, d)| x + w <= a || x >= c || y + h <= b || y >= d)
+        };
+        let (dx, dy) = candidates
+            .iter()
+            .copied()
+            .find(|&(dx, dy)| free(px + dx, py + dy))
+            .unwrap_or(candidates[0]);
+        let (x, y) = (px + dx, py + dy);
+        placed.push((x, y, x + w, y + h));
+        root.draw(&Text::new(p.label.clone(), (x, y), font.clone()))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    root.present().map_err(err)
+}
+
+/// Writes the speed–accuracy chart as SVG and PNG.
+pub fn speed_accuracy(pts: &[SpeedPoint], svg: &Path, png: &Path) -> DrawResult {
+    let size = (1200, 800);
+    draw_speed(&SVGBackend::new(svg, size).into_drawing_area(), pts)?;
+    draw_speed(&BitMapBackend::new(png, size).into_drawing_area(), pts)
+}
+
+/// One curve of the stability chart: name ("method f32"), whether f32 (dashed), points.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    /// Method name (one color per method).
+    pub method: String,
+    /// f32 curves are dashed, f64 solid.
+    pub is_f32: bool,
+    /// `(family parameter, error)`.
+    pub points: Vec<(f64, f64)>,
+}
+
+/// One panel of the stability chart (one family of `F`).
+#[derive(Clone, Debug)]
+pub struct Panel {
+    /// Title, e.g. "distance to J = 0".
+    pub title: String,
+    /// Description of the x axis.
+    pub x_desc: String,
+    /// The curves.
+    pub curves: Vec<Curve>,
+}
+
+fn draw_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    panel: &Panel,
+    methods: &[String],
+    y_desc: &str,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let all = || panel.curves.iter().flat_map(|c| c.points.iter());
+    let xr = log_range(all().map(|p| p.0), f64::MIN_POSITIVE);
+    let yr = log_range(all().map(|p| p.1), ERROR_FLOOR);
+    let mut chart = ChartBuilder::on(area)
+        .caption(&panel.title, (FONT, 18))
+        .margin(12)
+        .x_label_area_size(44)
+        .y_label_area_size(68)
+        .build_cartesian_2d(xr.log_scale(), yr.log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc(format!("{} (solid: f64, dashed: f32)", panel.x_desc))
+        .y_desc(y_desc)
+        .x_label_formatter(&sci)
+        .y_label_formatter(&sci)
+        .label_style((FONT, 12))
+        .axis_desc_style((FONT, 13))
+        .draw()
+        .map_err(err)?;
+    let mut legend: Vec<&str> = Vec::new();
+    for c in &panel.curves {
+        let mi = methods.iter().position(|m| *m == c.method).unwrap_or(0);
+        let col = color(mi);
+        let pts: Vec<(f64, f64)> = c
+            .points
+            .iter()
+            .filter(|p| p.0 > 0.0 && p.1.is_finite())
+            .map(|&(x, y)| (x, y.max(ERROR_FLOOR)))
+            .collect();
+        let anno = if c.is_f32 {
+            chart
+                .draw_series(DashedLineSeries::new(
+                    pts.clone(),
+                    6,
+                    4,
+                    col.stroke_width(2),
+                ))
+                .map_err(err)?
+        } else {
+            chart
+                .draw_series(LineSeries::new(pts.clone(), col.stroke_width(2)))
+                .map_err(err)?
+        };
+        // One legend entry per method (color); the line style tells the precision.
+        if !legend.contains(&c.method.as_str()) {
+            legend.push(&c.method);
+            anno.label(c.method.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], col.stroke_width(2))
+            });
+        }
+        chart
+            .draw_series(pts.iter().map(|&p| Circle::new(p, 2, col.filled())))
+            .map_err(err)?;
+    }
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::UpperLeft)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 11))
+        .draw()
+        .map_err(err)
+}
+
+/// Writes the stability chart (one panel per family) as SVG.
+pub fn stability(panels: &[Panel], y_desc: &str, svg: &Path) -> DrawResult {
+    let mut methods: Vec<String> = Vec::new();
+    for c in panels.iter().flat_map(|p| p.curves.iter()) {
+        if !methods.contains(&c.method) {
+            methods.push(c.method.clone());
+        }
+    }
+    let cols = panels.len().clamp(1, 2);
+    let rows = panels.len().div_ceil(cols).max(1);
+    let root = SVGBackend::new(svg, (700 * cols as u32, 520 * rows as u32)).into_drawing_area();
+    root.fill(&WHITE).map_err(err)?;
+    for (area, panel) in root.split_evenly((rows, cols)).iter().zip(panels) {
+        draw_panel(area, panel, &methods, y_desc)?;
+    }
+    root.present().map_err(err)
+}
