@@ -1,8 +1,10 @@
 //! The vectorized batch path (`ampm_core::batch`, `ampm_*_batch_*`) and the McAdams SVD.
 //!
 //! 1. Lane primitives equal their scalar counterparts bit for bit (the basis of 2.).
-//! 2. The C ABI batch functions equal, bit for bit and status for status, the scalar kernels
-//!    with the same SVD method (`BatchKernel::method()`), for every dim × precision, for
+//! 2. The C ABI batch functions equal, bit for bit and status for status, the single-particle
+//!    kernels with the default method, and the core lane path (`batch::ahat_batch`, the one
+//!    behind the 2D C functions) equals the scalar kernels with its method
+//!    (`BatchKernel::method()`: closed form in 2D, McAdams in 3D), for every dim × precision, for
 //!    n = 0..2N+3 (every remainder), with invalid particles of every kind sprinkled in;
 //!    failed outputs are untouched, `first_failed` and the status are the first failure's;
 //!    in place (`out == f`) gives the same; NULL arrays only for n = 0.
@@ -14,7 +16,7 @@ use ampm_core::augmented::{self, Augmented};
 use ampm_core::batch::lane::{Lane, L};
 use ampm_core::batch::{self, BatchKernel};
 use ampm_core::energy::FixedCorotated;
-use ampm_core::polar::{McAdams, Svd, SvdMethod};
+use ampm_core::polar::{DefaultSvd, McAdams, Svd, SvdMethod};
 use ampm_core::{Error, Mat, Matrix, Real};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -282,8 +284,14 @@ fn check_outputs<T: Real, const D: usize>(
     }
 }
 
-fn batch_equals_scalar<T: Real, const D: usize>(ahat_fn: AhatFn<T>, chat_fn: ChatFn<T>)
-where
+/// `abi`: the SVD method the C ABI batch functions use for this dimension (the default
+/// method, so that batch and single calls agree); the core lane path is checked against
+/// `BatchKernel::method()`.
+fn batch_equals_scalar<T: Real, const D: usize, A: SvdMethod<Mat<T, D>>>(
+    ahat_fn: AhatFn<T>,
+    chat_fn: ChatFn<T>,
+    abi: A,
+) where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]>,
     Mat<T, D>: BatchKernel<Scalar = T>,
 {
@@ -300,6 +308,15 @@ where
             let exp_c: Vec<_> = (0..n)
                 .map(|i| {
                     Augmented::new(&FixedCorotated::with_method(mu[i], method), &f[i])
+                        .and_then(|s| s.chat_z(&z[i]))
+                })
+                .collect();
+            let abi_a: Vec<_> = (0..n)
+                .map(|i| augmented::ahat(&FixedCorotated::with_method(mu[i], abi), &f[i]))
+                .collect();
+            let abi_c: Vec<_> = (0..n)
+                .map(|i| {
+                    Augmented::new(&FixedCorotated::with_method(mu[i], abi), &f[i])
                         .and_then(|s| s.chat_z(&z[i]))
                 })
                 .collect();
@@ -327,29 +344,29 @@ where
             let mut out = sentinel.clone();
             let mut ff = usize::MAX;
             let st = unsafe { ahat_fn(n, mu.as_ptr(), fp, out.as_mut_ptr().cast(), &mut ff) };
-            check_outputs("ahat", &exp_a, &out, &sentinel, st, ff);
+            check_outputs("ahat", &abi_a, &out, &sentinel, st, ff);
             let mut out = sentinel.clone();
             let mut ff = usize::MAX;
             let st = unsafe { chat_fn(n, mu.as_ptr(), fp, zp, out.as_mut_ptr().cast(), &mut ff) };
-            check_outputs("chat_z", &exp_c, &out, &sentinel, st, ff);
+            check_outputs("chat_z", &abi_c, &out, &sentinel, st, ff);
             // In place: out == f (ahat), out == z (chat); failed particles keep their input.
             let mut inplace = f.clone();
             let p = inplace.as_mut_ptr().cast::<T>();
             let st = unsafe { ahat_fn(n, mu.as_ptr(), p, p, std::ptr::null_mut()) };
-            check_outputs("ahat in place", &exp_a, &inplace, &f, st, {
-                exp_a.iter().position(|r| r.is_err()).unwrap_or(n)
+            check_outputs("ahat in place", &abi_a, &inplace, &f, st, {
+                abi_a.iter().position(|r| r.is_err()).unwrap_or(n)
             });
             let mut inplace = z.clone();
             let p = inplace.as_mut_ptr().cast::<T>();
             let st = unsafe { chat_fn(n, mu.as_ptr(), fp, p, p, std::ptr::null_mut()) };
-            check_outputs("chat_z in place (z)", &exp_c, &inplace, &z, st, {
-                exp_c.iter().position(|r| r.is_err()).unwrap_or(n)
+            check_outputs("chat_z in place (z)", &abi_c, &inplace, &z, st, {
+                abi_c.iter().position(|r| r.is_err()).unwrap_or(n)
             });
             let mut inplace = f.clone();
             let p = inplace.as_mut_ptr().cast::<T>();
             let st = unsafe { chat_fn(n, mu.as_ptr(), p, zp, p, std::ptr::null_mut()) };
-            check_outputs("chat_z in place (f)", &exp_c, &inplace, &f, st, {
-                exp_c.iter().position(|r| r.is_err()).unwrap_or(n)
+            check_outputs("chat_z in place (f)", &abi_c, &inplace, &f, st, {
+                abi_c.iter().position(|r| r.is_err()).unwrap_or(n)
             });
             // The safe slice API of core.
             let mut out = sentinel.clone();
@@ -402,19 +419,35 @@ where
 
 #[test]
 fn batch_2d_f32() {
-    batch_equals_scalar::<f32, 2>(ampm::ampm_ahat_batch_2d_f32, ampm::ampm_chat_z_batch_2d_f32);
+    batch_equals_scalar::<f32, 2, _>(
+        ampm::ampm_ahat_batch_2d_f32,
+        ampm::ampm_chat_z_batch_2d_f32,
+        DefaultSvd,
+    );
 }
 #[test]
 fn batch_2d_f64() {
-    batch_equals_scalar::<f64, 2>(ampm::ampm_ahat_batch_2d_f64, ampm::ampm_chat_z_batch_2d_f64);
+    batch_equals_scalar::<f64, 2, _>(
+        ampm::ampm_ahat_batch_2d_f64,
+        ampm::ampm_chat_z_batch_2d_f64,
+        DefaultSvd,
+    );
 }
 #[test]
 fn batch_3d_f32() {
-    batch_equals_scalar::<f32, 3>(ampm::ampm_ahat_batch_3d_f32, ampm::ampm_chat_z_batch_3d_f32);
+    batch_equals_scalar::<f32, 3, _>(
+        ampm::ampm_ahat_batch_3d_f32,
+        ampm::ampm_chat_z_batch_3d_f32,
+        DefaultSvd,
+    );
 }
 #[test]
 fn batch_3d_f64() {
-    batch_equals_scalar::<f64, 3>(ampm::ampm_ahat_batch_3d_f64, ampm::ampm_chat_z_batch_3d_f64);
+    batch_equals_scalar::<f64, 3, _>(
+        ampm::ampm_ahat_batch_3d_f64,
+        ampm::ampm_chat_z_batch_3d_f64,
+        DefaultSvd,
+    );
 }
 
 // ---------------------------------------------------------------------------------------

@@ -345,7 +345,7 @@ pub unsafe extern "C" fn ampm_ahat_batch_3d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch::<Mat<f32, 3>>(n, mu, f, out, first_failed)
+    k::ahat_batch_per_particle::<Mat<f32, 3>>(n, mu, f, out, first_failed)
 }
 
 /// Computes Â for n particles: `out[i]` = Â(mu[i], F[i]).
@@ -362,7 +362,7 @@ pub unsafe extern "C" fn ampm_ahat_batch_3d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch::<Mat<f64, 3>>(n, mu, f, out, first_failed)
+    k::ahat_batch_per_particle::<Mat<f64, 3>>(n, mu, f, out, first_failed)
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -416,7 +416,7 @@ pub unsafe extern "C" fn ampm_chat_z_batch_3d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch::<Mat<f32, 3>>(n, mu, f, z, out, first_failed)
+    k::chat_z_batch_per_particle::<Mat<f32, 3>>(n, mu, f, z, out, first_failed)
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -434,5 +434,5 @@ pub unsafe extern "C" fn ampm_chat_z_batch_3d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch::<Mat<f64, 3>>(n, mu, f, z, out, first_failed)
+    k::chat_z_batch_per_particle::<Mat<f64, 3>>(n, mu, f, z, out, first_failed)
 }

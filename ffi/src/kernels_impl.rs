@@ -1,13 +1,17 @@
 //! Generic bodies of the kernel entry points (fixed corotated base energy, default method).
 
 //!
-//! The batch functions run the vectorized kernels of `ampm_core::batch` (2D: closed form;
-//! 3D: McAdams with the per-precision sweep count of `BatchKernel::SWEEPS`), dispatched at run
-//! time to an AVX2 compiled copy when the CPU has it. Their results equal, bit for
-//! bit, the scalar kernels with that method (`tests/batch.rs`); the single-particle functions
-//! keep the default method (one-sided Jacobi in 3D).
+//! Batch functions use the default method of each dimension, so a batch result equals the
+//! single-particle call bit for bit:
+//! - 2D: the vectorized closed form of `ampm_core::batch`, dispatched at run time to an AVX2
+//!   compiled copy when the CPU has it (bit-identical to the scalar closed form,
+//!   `tests/batch.rs`);
+//! - 3D: one-sided Jacobi, particle by particle. The vectorized McAdams path of
+//!   `ampm_core::batch` was measured only ~1.25× faster than this (tools/benches/batch.rs) at
+//!   the price of `O(ε κ²)` small singular values and results that differ from the single
+//!   calls, so it is not the default (README, "Choosing a method").
 
-use crate::abi::{binary, check_batch, guard, read_mat, unary, write_mat};
+use crate::abi::{batch, binary, check_batch, guard, read_mat, unary, write_mat};
 use crate::status::AmpmStatus;
 use ampm_core::augmented;
 use ampm_core::batch::{BatchKernel, MAX_LANES};
@@ -213,5 +217,53 @@ pub(crate) unsafe fn chat_z_batch<M: BatchKernel>(
             return st;
         }
         dispatch::<M>(n, mu, f, Some(z), out, first_failed)
+    })
+}
+
+/// `ahat_batch` particle by particle with the default method (3D).
+pub(crate) unsafe fn ahat_batch_per_particle<M: Matrix>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+) -> AmpmStatus
+where
+    DefaultSvd: SvdMethod<M>,
+{
+    guard(|| {
+        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), out.is_null()]);
+        if st != AmpmStatus::AMPM_OK {
+            return st;
+        }
+        batch::<M>(n, out, first_failed, |i| {
+            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
+            augmented::ahat(&e, &read_mat::<M>(f.add(i * M::LEN)))
+        })
+    })
+}
+
+/// `chat_z_batch` particle by particle with the default method (3D).
+pub(crate) unsafe fn chat_z_batch_per_particle<M: Matrix>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    z: *const M::Scalar,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+) -> AmpmStatus
+where
+    DefaultSvd: SvdMethod<M>,
+{
+    guard(|| {
+        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
+        if st != AmpmStatus::AMPM_OK {
+            return st;
+        }
+        batch::<M>(n, out, first_failed, |i| {
+            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
+            let zi = read_mat::<M>(z.add(i * M::LEN));
+            augmented::chat_z(&e, &read_mat::<M>(f.add(i * M::LEN)), &zi)
+        })
     })
 }

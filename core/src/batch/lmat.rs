@@ -139,22 +139,32 @@ pub fn scale_exponent<S: Lane, const D: usize>(a: &LMat<S, D>) -> S {
     m.exponent()
 }
 
-/// `polar::scale_pow2`: `a · 2ᵉ` in two exact steps, `e` integer-valued.
+/// `a · 2ᵉ`, `e` integer-valued, in three power-of-two factors of at most `3|e|/8` each, so
+/// that no factor overflows for any exponent the kernels produce (`|e| ≤ 2·1074 + 2` in f64):
+/// `0 · 2ᵉ` stays 0 where a two-factor split gave `0 · inf = NaN`. Exact unless the result
+/// leaves the normal range (like `polar::scale_pow2`, which rounds such results once; here an
+/// intermediate underflow may round twice, at most one subnormal ulp).
 #[inline(always)]
 #[must_use]
 pub fn scale_pow2<S: Lane, const D: usize>(a: &LMat<S, D>, e: S) -> LMat<S, D> {
-    let h = S::half_trunc(e);
-    let p1 = S::pow2(h);
-    let p2 = S::pow2(e - h);
-    entries!(a, j, i => a[j][i] * p1 * p2)
+    let (p1, p2, p3) = pow2_split(e);
+    entries!(a, j, i => a[j][i] * p1 * p2 * p3)
 }
 
-/// `x · 2ᵉ` in two exact steps (as `scale_pow2` on one entry).
+/// `x · 2ᵉ` (as [`scale_pow2`] on one entry).
 #[inline(always)]
 #[must_use]
 pub fn scale_pow2_scalar<S: Lane>(x: S, e: S) -> S {
-    let h = S::half_trunc(e);
-    x * S::pow2(h) * S::pow2(e - h)
+    let (p1, p2, p3) = pow2_split(e);
+    x * p1 * p2 * p3
+}
+
+/// `2ᵉ = 2^q · 2^h · 2^(e−q−h)` with `q ≈ e/4`, `h ≈ 3e/8`.
+#[inline(always)]
+fn pow2_split<S: Lane>(e: S) -> (S, S, S) {
+    let q = S::half_trunc(S::half_trunc(e));
+    let h = S::half_trunc(e - q);
+    (S::pow2(q), S::pow2(h), S::pow2(e - q - h))
 }
 
 /// Cross product (as `mat::cross`).
