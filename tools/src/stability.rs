@@ -824,6 +824,14 @@ fn measure_case<T: Real, const D: usize>(
             }
         }
     }
+    // Kernel errors of matrices singular to working precision are outside every contract
+    // (and would dominate the statistics): not counted.
+    if sc.near_singular {
+        for i in 2..5 {
+            ce.err[i] = None;
+            ce.raw[i] = None;
+        }
+    }
     cell.record(ce);
 }
 
@@ -1055,7 +1063,8 @@ pub fn table_markdown(report: &Report) -> String {
          ε·κ (ε of the precision; κ per quantity as defined in `tools/src/stability.rs`: \
          κ_R = 2σ₀/min(σᵢ+σⱼ) for R, 1 for Σ relative to σ₀, κ_K = max(κ_R, σ₀/σ_min, \
          ∏‖fⱼ‖/|J|) for Ψ̂, Â, Ĉ:Z with their scales). \"max / p99\" over the family's \
-         matrices; – where not measured (no J > 0, or R not unique). Statuses: kernels \
+         matrices; – where not measured (no J > 0, or R not unique); kernel errors of matrices \
+         singular to working precision (4d·ε·∏‖fⱼ‖/|J| ≥ 1) are not counted. Statuses: kernels \
          ok / NonPositiveJ / Overflow / NonFinite. Family size: {:?}.\n",
         report.size
     );

@@ -28,7 +28,9 @@
 //! *Matrix Computations*, 4th ed., §8.5.2–8.5.3): unconditionally convergent and backward
 //! stable, so the eigenvector has the error `O(ε‖B‖/gap) = O(ε‖F‖/(σ₁+σ₂))` that the
 //! conditioning allows, with no special cases for nearly repeated or zero eigenvalues — at the
-//! price of speed (≈ 4–6 sweeps of 6 rotations on a 4×4, then a 3×3 Jacobi for `V`).
+//! price of speed: at most 6 sweeps of 6 rotations on the 4×4 were needed over every family of
+//! `tools/src/families.rs` (4 suffice for all but ~10 % in f64), then a 3×3 Jacobi for `V`;
+//! about twice the time of one-sided Jacobi.
 //!
 //! **Then Σ and V** (so that the method serves the fixed corotated energy, which needs `σᵢ` and
 //! `V` for `δR`): `S = sym(RᵀF)` is diagonalised by the same Jacobi iteration (3×3),
@@ -58,7 +60,7 @@ pub struct HighamNoferini {
 }
 
 impl Default for HighamNoferini {
-    /// 16 sweeps: Jacobi converges quadratically, 4–6 sweeps are the norm.
+    /// 16 sweeps: Jacobi converges quadratically; 6 is the largest count observed.
     fn default() -> Self {
         Self { max_sweeps: 16 }
     }

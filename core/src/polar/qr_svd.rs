@@ -27,8 +27,9 @@
 //! perturbation bound `‖ΔR‖_F ≤ 2‖ΔF‖_F/(σ_{d−1}+σ_d)`, R.-C. Li 1995), whatever the scale.
 //!
 //! **Iteration cap.** Each sweep reduces the last off-diagonal `β₁` cubically once it is small
-//! (Wilkinson shift), so 2–4 sweeps per split are typical and the measured maximum over the
-//! families of `tools/src/families.rs` is far below the default cap of 32. The method returns
+//! (Wilkinson shift): over every family of `tools/src/families.rs` (about 30 000 matrices per
+//! precision) the largest number of sweeps needed is 6 in f64 and 5 in f32, against the
+//! default cap of 32. The method returns
 //! [`Error::NotConverged`] only if both `β` are still above the tolerance after
 //! `max_iterations` sweeps (it has never been observed; the shifted QR iteration is globally
 //! convergent for symmetric tridiagonal `BᵀB`, Wilkinson 1968).
@@ -47,7 +48,7 @@ pub struct QrSvd {
 }
 
 impl Default for QrSvd {
-    /// 32 sweeps: an order of magnitude above the largest count observed.
+    /// 32 sweeps: five times the largest count observed (6, f64).
     fn default() -> Self {
         Self { max_iterations: 32 }
     }
