@@ -129,3 +129,61 @@ pub(crate) fn check_batch<M: Matrix>(n: usize, ptrs: &[bool]) -> AmpmStatus {
         _ => AmpmStatus::AMPM_ERR_INVALID_ARGUMENT,
     }
 }
+
+/// A whole batch call of a per-particle kernel of `(μᵢ, Fᵢ)`: panic guard, pointer and size
+/// checks, then [`batch`].
+///
+/// # Safety
+/// Non-null `mu` valid for `n` scalars, `f` and `out` for `n·M::LEN`.
+#[inline]
+pub(crate) unsafe fn batch_mu_f<M: Matrix>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+    mut k: impl FnMut(M::Scalar, &M) -> Result<M, Error>,
+) -> AmpmStatus {
+    guard(|| {
+        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), out.is_null()]);
+        if st != AmpmStatus::AMPM_OK {
+            return st;
+        }
+        batch::<M>(n, out, first_failed, |i| {
+            k(
+                ptr::read_unaligned(mu.add(i)),
+                &read_mat::<M>(f.add(i * M::LEN)),
+            )
+        })
+    })
+}
+
+/// A whole batch call of a per-particle kernel of `(μᵢ, Fᵢ, Zᵢ)` (as [`batch_mu_f`]).
+///
+/// # Safety
+/// Non-null `mu` valid for `n` scalars, `f`, `z` and `out` for `n·M::LEN`.
+#[inline]
+pub(crate) unsafe fn batch_mu_f_z<M: Matrix>(
+    n: usize,
+    mu: *const M::Scalar,
+    f: *const M::Scalar,
+    z: *const M::Scalar,
+    out: *mut M::Scalar,
+    first_failed: *mut usize,
+    mut k: impl FnMut(M::Scalar, &M, &M) -> Result<M, Error>,
+) -> AmpmStatus {
+    guard(|| {
+        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
+        if st != AmpmStatus::AMPM_OK {
+            return st;
+        }
+        batch::<M>(n, out, first_failed, |i| {
+            let zi = read_mat::<M>(z.add(i * M::LEN));
+            k(
+                ptr::read_unaligned(mu.add(i)),
+                &read_mat::<M>(f.add(i * M::LEN)),
+                &zi,
+            )
+        })
+    })
+}

@@ -12,7 +12,7 @@ use ampm_core::Mat;
 
 /// Generic bodies of the entry points of this module.
 mod imp {
-    use crate::abi::{batch, binary, check_batch, guard, read_mat};
+    use crate::abi::{batch_mu_f_z, binary, guard, read_mat};
     use crate::status::AmpmStatus;
     use ampm_core::energy::FixedCorotated;
     use ampm_core::hessian::{self, HessianDim};
@@ -72,16 +72,8 @@ mod imp {
     where
         DefaultSvd: SvdMethod<M>,
     {
-        guard(|| {
-            let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
-            if st != AmpmStatus::AMPM_OK {
-                return st;
-            }
-            batch::<M>(n, out, first_failed, |i| {
-                let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
-                let zi = read_mat::<M>(z.add(i * M::LEN));
-                hessian::chat_psd_z(&e, &read_mat::<M>(f.add(i * M::LEN)), &zi)
-            })
+        batch_mu_f_z::<M>(n, mu, f, z, out, first_failed, |mu, f, z| {
+            hessian::chat_psd_z(&FixedCorotated::new(mu), f, z)
         })
     }
 

@@ -11,7 +11,9 @@
 //!   the price of `O(ε κ²)` small singular values and results that differ from the single
 //!   calls, so it is not the default (README, "Choosing a method").
 
-use crate::abi::{batch, binary, check_batch, guard, read_mat, unary, write_mat};
+use crate::abi::{
+    batch_mu_f, batch_mu_f_z, binary, check_batch, guard, read_mat, unary, write_mat,
+};
 use crate::status::AmpmStatus;
 use ampm_core::augmented;
 use ampm_core::batch::{BatchKernel, MAX_LANES};
@@ -231,15 +233,8 @@ pub(crate) unsafe fn ahat_batch_per_particle<M: Matrix>(
 where
     DefaultSvd: SvdMethod<M>,
 {
-    guard(|| {
-        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), out.is_null()]);
-        if st != AmpmStatus::AMPM_OK {
-            return st;
-        }
-        batch::<M>(n, out, first_failed, |i| {
-            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
-            augmented::ahat(&e, &read_mat::<M>(f.add(i * M::LEN)))
-        })
+    batch_mu_f::<M>(n, mu, f, out, first_failed, |mu, f| {
+        augmented::ahat(&FixedCorotated::new(mu), f)
     })
 }
 
@@ -255,15 +250,7 @@ pub(crate) unsafe fn chat_z_batch_per_particle<M: Matrix>(
 where
     DefaultSvd: SvdMethod<M>,
 {
-    guard(|| {
-        let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
-        if st != AmpmStatus::AMPM_OK {
-            return st;
-        }
-        batch::<M>(n, out, first_failed, |i| {
-            let e = FixedCorotated::new(ptr::read_unaligned(mu.add(i)));
-            let zi = read_mat::<M>(z.add(i * M::LEN));
-            augmented::chat_z(&e, &read_mat::<M>(f.add(i * M::LEN)), &zi)
-        })
+    batch_mu_f_z::<M>(n, mu, f, z, out, first_failed, |mu, f, z| {
+        augmented::chat_z(&FixedCorotated::new(mu), f, z)
     })
 }
