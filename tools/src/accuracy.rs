@@ -137,7 +137,12 @@ fn qi(q: Quantity) -> usize {
 /// The methods table: timings and p99 errors.
 #[must_use]
 pub fn render_methods(timings: &[MethodTiming], acc: &Accuracy) -> String {
-    let shown = [Quantity::R, Quantity::Sigma, Quantity::Ahat, Quantity::ChatZ];
+    let shown = [
+        Quantity::R,
+        Quantity::Sigma,
+        Quantity::Ahat,
+        Quantity::ChatZ,
+    ];
     let mut headers = vec![
         "method".to_string(),
         "d".into(),

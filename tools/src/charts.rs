@@ -180,10 +180,11 @@ where
         let filled = c.filled();
         let at = |p: &SpeedPoint| (p.ns_kernels, p.p99.max(ERROR_FLOOR));
         let f64s = chart
-            .draw_series(mine.iter().filter(|p| !p.is_f32).map(|p| {
-                EmptyElement::at(at(p))
-                    + Circle::new((0, 0), 5, filled)
-            }))
+            .draw_series(
+                mine.iter()
+                    .filter(|p| !p.is_f32)
+                    .map(|p| EmptyElement::at(at(p)) + Circle::new((0, 0), 5, filled)),
+            )
             .map_err(err)?;
         let f64_count = mine.iter().filter(|p| !p.is_f32).count();
         if f64_count > 0 {
@@ -191,10 +192,11 @@ where
                 .legend(move |(x, y)| Circle::new((x + 8, y), 5, filled));
         }
         let f32s = chart
-            .draw_series(mine.iter().filter(|p| p.is_f32).map(|p| {
-                EmptyElement::at(at(p))
-                    + TriangleMarker::new((0, 0), 7, filled)
-            }))
+            .draw_series(
+                mine.iter()
+                    .filter(|p| p.is_f32)
+                    .map(|p| EmptyElement::at(at(p)) + TriangleMarker::new((0, 0), 7, filled)),
+            )
             .map_err(err)?;
         if f64_count == 0 {
             f32s.label(m.to_string())

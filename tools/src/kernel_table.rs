@@ -13,11 +13,11 @@
 //!   units of `ε₃₂ = 2⁻²³`.
 
 use crate::timing::median_ns_per_particle;
+use ampm::AmpmStatus;
 use ampm_core::augmented;
 use ampm_core::energy::FixedCorotated;
 use ampm_core::polar::{DefaultSvd, SvdMethod};
 use ampm_core::{Mat, Matrix, Real};
-use ampm::AmpmStatus;
 use ampm_tools::workload::{cast_particles, FfiArrays, FfiBatch};
 use std::hint::black_box;
 
@@ -147,9 +147,7 @@ where
         Kernel::ZB => augmented::z_b(f, z).ok().map(|m| flat(&m)),
         Kernel::PsiHat => augmented::psi_hat(&e, f).ok().map(|p| vec![p.to_f64()]),
         Kernel::AHat | Kernel::AHatBatch => augmented::ahat(&e, f).ok().map(|m| flat(&m)),
-        Kernel::ChatZ | Kernel::ChatZBatch => {
-            augmented::chat_z(&e, f, z).ok().map(|m| flat(&m))
-        }
+        Kernel::ChatZ | Kernel::ChatZBatch => augmented::chat_z(&e, f, z).ok().map(|m| flat(&m)),
     }
 }
 
@@ -167,7 +165,11 @@ fn central<M: Matrix<Scalar = f64>>(
 
 /// Gradient of a scalar `g` by central differences along every `E_ij`, flattened
 /// column-major like the kernels' outputs.
-fn gradient<M: Matrix<Scalar = f64>>(g: &impl Fn(&M) -> Option<f64>, f: &M, h: f64) -> Option<Vec<f64>> {
+fn gradient<M: Matrix<Scalar = f64>>(
+    g: &impl Fn(&M) -> Option<f64>,
+    f: &M,
+    h: f64,
+) -> Option<Vec<f64>> {
     let mut out = vec![0.0; M::LEN];
     for j in 0..M::DIM {
         for i in 0..M::DIM {
@@ -196,9 +198,7 @@ where
         Kernel::BZ => central(&f_hat::<M>, f, z, h),
         Kernel::ZB => gradient(&|g: &M| f_hat(g).map(|fh| z.ddot(&fh)), f, h),
         Kernel::PsiHat => None,
-        Kernel::AHat | Kernel::AHatBatch => {
-            gradient(&|g: &M| augmented::psi_hat(&e, g).ok(), f, h)
-        }
+        Kernel::AHat | Kernel::AHatBatch => gradient(&|g: &M| augmented::psi_hat(&e, g).ok(), f, h),
         Kernel::ChatZ | Kernel::ChatZBatch => {
             central(&|g: &M| augmented::ahat(&e, g).ok(), f, z, h)
         }

@@ -6,8 +6,8 @@
 //! of `𝓑:Z`, `Ĉ:Z`) has entries uniform in `[−1, 1]`, scaled to unit Frobenius norm. Everything
 //! is drawn in `f64` from a seeded PCG, so every run sees the same particles.
 
-use ampm_core::{Mat, Matrix};
 use ampm::AmpmStatus;
+use ampm_core::{Mat, Matrix};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
 
