@@ -18,68 +18,24 @@ use ampm_core::batch::{self, BatchKernel};
 use ampm_core::energy::FixedCorotated;
 use ampm_core::polar::{DefaultSvd, McAdams, Svd, SvdMethod};
 use ampm_core::{Error, Mat, Matrix, Real};
+use ampm_tools::workload::HaarRotation;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
-
-/// A random rotation (normalised random quaternion in 3D, random angle in 2D).
-fn rotation<const D: usize>(rng: &mut Pcg64) -> Mat<f64, D>
-where
-    Mat<f64, D>: Matrix<Scalar = f64>,
-{
-    let mut m = Mat::<f64, D>::identity();
-    if D == 2 {
-        let t: f64 = rng.random_range(-3.2..3.2);
-        m[(0, 0)] = t.cos();
-        m[(1, 0)] = t.sin();
-        m[(0, 1)] = -t.sin();
-        m[(1, 1)] = t.cos();
-        return m;
-    }
-    let q = loop {
-        let q: [f64; 4] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
-        let n: f64 = q.iter().map(|x| x * x).sum();
-        if (0.01..1.0).contains(&n) {
-            break q.map(|x| x / n.sqrt());
-        }
-    };
-    let [w, x, y, z] = q;
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    for i in 0..D {
-        for j in 0..D {
-            m[(i, j)] = r[i][j];
-        }
-    }
-    m
-}
 
 /// `F = R₁ diag(σ) R₂ᵀ`, σ log-uniform in `[lo, hi]` (det F > 0).
 fn family<const D: usize>(rng: &mut Pcg64, lo: f64, hi: f64) -> Mat<f64, D>
 where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]>,
+    Mat<f64, D>: HaarRotation,
 {
     let s: [f64; D] = std::array::from_fn(|_| rng.random_range(lo.ln()..hi.ln()).exp());
-    rotation::<D>(rng) * Mat::from_diagonal(s) * rotation::<D>(rng).transpose()
+    <Mat<f64, D>>::haar(rng) * Mat::from_diagonal(s) * <Mat<f64, D>>::haar(rng).transpose()
 }
 
 fn random_z<const D: usize>(rng: &mut Pcg64) -> Mat<f64, D>
 where
     Mat<f64, D>: Matrix<Scalar = f64>,
+    Mat<f64, D>: HaarRotation,
 {
     Mat::from_cols(std::array::from_fn(|_| {
         std::array::from_fn(|_| rng.random_range(-1.0..1.0))
@@ -208,6 +164,7 @@ fn make<T: Real, const D: usize>(
 ) -> (Vec<T>, Vec<Mat<T, D>>, Vec<Mat<T, D>>)
 where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]>,
+    Mat<f64, D>: HaarRotation,
     Mat<T, D>: Matrix<Scalar = T>,
 {
     let (mut mu, mut f, mut z) = (vec![], vec![], vec![]);
@@ -293,6 +250,7 @@ fn batch_equals_scalar<T: Real, const D: usize, A: SvdMethod<Mat<T, D>>>(
     abi: A,
 ) where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]>,
+    Mat<f64, D>: HaarRotation,
     Mat<T, D>: BatchKernel<Scalar = T>,
 {
     let lanes = <Mat<T, D> as BatchKernel>::LANES;
@@ -508,6 +466,7 @@ nalgebra_svd!(3);
 fn batch_accuracy<T: Real, const D: usize>(ahat_fn: AhatFn<T>, chat_fn: ChatFn<T>) -> (f64, f64)
 where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]>,
+    Mat<f64, D>: HaarRotation,
     Mat<T, D>: BatchKernel<Scalar = T>,
     NalgebraSvd: SvdMethod<Mat<f64, D>>,
 {

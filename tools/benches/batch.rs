@@ -17,6 +17,7 @@
 
 use ampm_core::batch::{ahat_one, chat_z_one, BatchKernel};
 use ampm_core::{Mat, Matrix, Real};
+use ampm_tools::workload::HaarRotation;
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use rand::{Rng, SeedableRng};
 use std::hint::black_box;
@@ -24,65 +25,20 @@ use std::time::Duration;
 
 const N: usize = 4096;
 
-/// A random rotation (normalised random quaternion; 2D: a random angle).
-fn rotation<const D: usize>(rng: &mut impl Rng) -> Mat<f64, D>
-where
-    Mat<f64, D>: Matrix<Scalar = f64>,
-{
-    let mut m = Mat::<f64, D>::identity();
-    if D == 2 {
-        let t: f64 = rng.random_range(-3.2..3.2);
-        m[(0, 0)] = t.cos();
-        m[(1, 0)] = t.sin();
-        m[(0, 1)] = -t.sin();
-        m[(1, 1)] = t.cos();
-        return m;
-    }
-    let q = loop {
-        let q: [f64; 4] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
-        let n: f64 = q.iter().map(|x| x * x).sum();
-        if (0.01..1.0).contains(&n) {
-            break q.map(|x| x / n.sqrt());
-        }
-    };
-    let [w, x, y, z] = q;
-    let r = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    for i in 0..D {
-        for j in 0..D {
-            m[(i, j)] = r[i][j];
-        }
-    }
-    m
-}
-
 /// `n` particles `(F, Z)` of the accuracy family, flattened column-major.
 fn particles<T: Real, const D: usize>(n: usize) -> (Vec<T>, Vec<T>, Vec<T>)
 where
     Mat<f64, D>: Matrix<Scalar = f64>,
+    Mat<f64, D>: HaarRotation,
     Mat<T, D>: Matrix<Scalar = T>,
 {
     let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
     let (mut f, mut z) = (Vec::new(), Vec::new());
     for _ in 0..n {
         let s: [f64; D] = std::array::from_fn(|_| rng.random_range(0.2f64.ln()..5f64.ln()).exp());
-        let fm =
-            rotation::<D>(&mut rng) * Mat::from_diagonal(s) * rotation::<D>(&mut rng).transpose();
+        let fm = <Mat<f64, D>>::haar(&mut rng)
+            * Mat::from_diagonal(s)
+            * <Mat<f64, D>>::haar(&mut rng).transpose();
         let zm = Mat::<f64, D>::from_cols(std::array::from_fn(|_| {
             std::array::from_fn(|_| rng.random_range(-1.0..1.0))
         }));
