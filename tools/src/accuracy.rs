@@ -37,6 +37,7 @@ pub const METHODS_NOTE: &str = "Time per particle (median, one core) of Â + Ĉ:
 
 /// Display name of a method (`SvdMethod::NAME` → chart legend).
 #[must_use]
+#[inline]
 pub fn display_name(key: &str) -> &str {
     match key {
         "closed-form-2d" => "closed form",
@@ -74,6 +75,8 @@ pub struct Accuracy {
 }
 
 /// Runs the stability measurement family by family (one progress step each).
+#[inline]
+#[must_use]
 pub fn measure(size: Size, mut progress: impl FnMut()) -> Accuracy {
     let mut report = Report {
         size,
@@ -136,6 +139,7 @@ fn qi(q: Quantity) -> usize {
 
 /// The methods table: timings and p99 errors.
 #[must_use]
+#[inline]
 pub fn render_methods(timings: &[MethodTiming], acc: &Accuracy) -> String {
     let shown = [
         Quantity::R,
@@ -174,6 +178,7 @@ pub fn render_methods(timings: &[MethodTiming], acc: &Accuracy) -> String {
 
 /// The points of the speed–accuracy chart: the timed configurations that have an error.
 #[must_use]
+#[inline]
 pub fn speed_points(timings: &[MethodTiming], acc: &Accuracy) -> Vec<SpeedPoint> {
     timings
         .iter()

@@ -21,6 +21,7 @@ const FONT_CANDIDATES: [&str; 3] = [
 const FONT: &str = "sans-serif";
 
 /// Reads and registers the charts' font; says what to install when none is found.
+#[inline]
 pub fn init_font() -> Result<String, String> {
     let env = std::env::var("AMPM_FONT").ok();
     let path = env
@@ -246,6 +247,7 @@ where
 }
 
 /// Writes the speed–accuracy chart as SVG and PNG.
+#[inline]
 pub fn speed_accuracy(pts: &[SpeedPoint], svg: &Path, png: &Path) -> DrawResult {
     let size = (1200, 800);
     draw_speed(&SVGBackend::new(svg, size).into_drawing_area(), pts)?;
@@ -349,6 +351,7 @@ where
 }
 
 /// Writes the stability chart (one panel per family) as SVG.
+#[inline]
 pub fn stability(panels: &[Panel], y_desc: &str, svg: &Path) -> DrawResult {
     let mut methods: Vec<String> = Vec::new();
     for c in panels.iter().flat_map(|p| p.curves.iter()) {

@@ -54,6 +54,7 @@ impl Kernel {
 
     /// Name in the table.
     #[must_use]
+    #[inline]
     pub fn name(self) -> &'static str {
         match self {
             Kernel::BZ => "𝓑:Z",
@@ -282,7 +283,12 @@ where
     (outs, same && ((st == AmpmStatus::AMPM_OK) == all_ok))
 }
 
+/// A reference result at `(F, Z)` in f64 (`None` where there is none).
+type Reference<'a, const D: usize> = dyn Fn(&Mat<f64, D>, &Mat<f64, D>) -> Option<Vec<f64>> + 'a;
+
 /// The rows of one dimension × precision, measured on `parts` (drawn in f64, rounded to `T`).
+#[inline]
+#[must_use]
 pub fn measure<T: Real, const D: usize>(
     cfg: Config,
     parts64: &[(Mat<f64, D>, Mat<f64, D>)],
@@ -309,7 +315,7 @@ where
                 }
                 _ => (parts.iter().map(|(f, z)| eval(k, f, z)).collect(), None),
             };
-            let compare = |reference: &dyn Fn(&Mat<f64, D>, &Mat<f64, D>) -> Option<Vec<f64>>| {
+            let compare = |reference: &Reference<'_, D>| {
                 let mut errs = Vec::with_capacity(outs.len());
                 let mut failed = 0;
                 for (o, (f, z)) in outs.iter().zip(&wide) {
@@ -354,6 +360,7 @@ fn fmt_err(x: f64, in_eps32: bool) -> String {
 
 /// The table as aligned markdown.
 #[must_use]
+#[inline]
 pub fn render(rows: &[Row]) -> String {
     let mut t = crate::table::markdown(&[
         "kernel",

@@ -39,6 +39,7 @@ pub struct MethodTiming {
 impl MethodTiming {
     /// "McAdams 4" or "one-sided Jacobi".
     #[must_use]
+    #[inline]
     pub fn label(&self) -> String {
         match self.sweeps {
             Some(s) => format!("{} {s}", self.method),
@@ -103,6 +104,8 @@ where
 }
 
 /// Times every method configuration in precision `T`, calling `progress` after each.
+#[inline]
+#[must_use]
 pub fn measure<T: Real>(size: Size, reps: usize, mut progress: impl FnMut()) -> Vec<MethodTiming> {
     let q2 = batch::<T, 2>(size);
     let q3 = batch::<T, 3>(size);

@@ -5,6 +5,7 @@ use comfy_table::{presets::ASCII_MARKDOWN, CellAlignment, ContentArrangement, Ta
 
 /// An empty markdown table with these column headers (no wrapping: rows stay one line).
 #[must_use]
+#[inline]
 pub fn markdown(headers: &[&str]) -> Table {
     let mut t = Table::new();
     t.load_preset(ASCII_MARKDOWN)
@@ -14,6 +15,7 @@ pub fn markdown(headers: &[&str]) -> Table {
 }
 
 /// Right-aligns the numeric columns `cols`.
+#[inline]
 pub fn right_align(t: &mut Table, cols: &[usize]) {
     for &c in cols {
         if let Some(col) = t.column_mut(c) {

@@ -11,6 +11,7 @@ use std::time::Instant;
 /// Median nanoseconds per particle of `pass`, which processes `n` particles, over `reps`
 /// timed passes (after one untimed warm-up pass).
 #[must_use]
+#[inline]
 pub fn median_ns_per_particle(n: usize, reps: usize, mut pass: impl FnMut()) -> f64 {
     pass();
     let mut samples: Vec<f64> = (0..reps.max(1))

@@ -101,6 +101,7 @@ pub fn random_direction<M: Matrix<Scalar = f64>>(rng: &mut impl Rng) -> M {
 
 /// `n` random particles `(F, Z)` of dimension `D`, from stream `stream`.
 #[must_use]
+#[inline]
 pub fn particles<const D: usize>(n: usize, stream: u64) -> Vec<(Mat<f64, D>, Mat<f64, D>)>
 where
     Mat<f64, D>: HaarRotation,
@@ -192,6 +193,7 @@ pub struct FfiArrays<M: Matrix> {
 impl<M: Matrix + FfiBatch> FfiArrays<M> {
     /// Packs particles (already in the precision of `M`) with a common `μ`.
     #[must_use]
+    #[inline]
     pub fn new(mu: M::Scalar, parts: &[(M, M)]) -> Self {
         let n = parts.len();
         let mut f = Vec::with_capacity(n * M::LEN);
@@ -211,6 +213,7 @@ impl<M: Matrix + FfiBatch> FfiArrays<M> {
 
     /// `Â` of every particle into `out` (C ABI); the status and the first failed index.
     #[inline]
+    #[must_use]
     pub fn ahat(&mut self) -> (AmpmStatus, usize) {
         let mut first = usize::MAX;
         // SAFETY: every array holds `n` particles (built by `new`).
@@ -228,6 +231,7 @@ impl<M: Matrix + FfiBatch> FfiArrays<M> {
 
     /// `Ĉ:Z` of every particle into `out` (C ABI); the status and the first failed index.
     #[inline]
+    #[must_use]
     pub fn chat_z(&mut self) -> (AmpmStatus, usize) {
         let mut first = usize::MAX;
         // SAFETY: every array holds `n` particles (built by `new`).
@@ -258,6 +262,7 @@ impl<M: Matrix + FfiBatch> FfiArrays<M> {
 /// Rounds `f64` particles to the precision `T` (the inputs of the `T` kernels; cast back to
 /// `f64` they are the exactly representable inputs of the `f64` comparison run).
 #[must_use]
+#[inline]
 pub fn cast_particles<T: ampm_core::Real, const D: usize>(
     parts: &[(Mat<f64, D>, Mat<f64, D>)],
 ) -> Vec<(Mat<T, D>, Mat<T, D>)> {
