@@ -11,6 +11,8 @@
 //   equation, 𝓑 and Ĉ are explicit 4-index tensors built from the seed's index formulas.
 //   test_kernels_eigen.cpp checks it against central finite differences.
 // - `Api<T, D>`: the 14 kernel symbols of one (scalar, dimension), for generic tests.
+// - `IsaRestore`, `simd_isas()`, `isa_name()`: the instruction set of the batch calls
+//   (`ampm_set_isa` / `ampm_isa`), for running a batch test on each one.
 //
 // Conventions: matrices are column-major, as in the C ABI (`F[i + d*j] = F_ij`) and Eigen's
 // default, so `Eigen::Matrix<T, D, D>::data()` can be passed straight to the library. A 4-index
@@ -34,6 +36,7 @@
 #include <limits>
 #include <random>
 #include <type_traits>
+#include <vector>
 
 namespace ampm_test {
 
@@ -85,6 +88,7 @@ inline const char* status_name(AmpmStatus s) {
     case AMPM_ERR_INVALID_ARGUMENT: return "AMPM_ERR_INVALID_ARGUMENT";
     case AMPM_ERR_NOT_CONVERGED: return "AMPM_ERR_NOT_CONVERGED";
     case AMPM_ERR_INTERNAL: return "AMPM_ERR_INTERNAL";
+    case AMPM_ERR_NOT_PREPARED: return "AMPM_ERR_NOT_PREPARED";
   }
   return "(unknown AmpmStatus)";
 }
@@ -95,6 +99,42 @@ inline const char* status_name(AmpmStatus s) {
     AMPM_CHECK(ck, ampm_st_ == (expected), "%s returned %s, expected %s", #call,            \
                ::ampm_test::status_name(ampm_st_), ::ampm_test::status_name(expected));     \
   } while (0)
+
+// ---- instruction sets of the batch calls ---------------------------------------------------
+
+inline const char* isa_name(std::uint32_t isa) {
+  switch (isa) {
+    case AMPM_ISA_SCALAR: return "scalar";
+    case AMPM_ISA_AVX2: return "AVX2";
+    case AMPM_ISA_AVX512: return "AVX-512";
+  }
+  return "(unknown ISA)";
+}
+
+/// Restores the instruction set of the batch calls (`ampm_isa()` at construction) when it
+/// goes out of scope, so a test that switches ISAs leaves the process as it found it.
+class IsaRestore {
+ public:
+  IsaRestore() : prev_(ampm_isa()) {}
+  ~IsaRestore() { ampm_set_isa(prev_); }
+  IsaRestore(const IsaRestore&) = delete;
+  IsaRestore& operator=(const IsaRestore&) = delete;
+  std::uint32_t previous() const { return prev_; }
+
+ private:
+  std::uint32_t prev_;
+};
+
+/// The SIMD instruction sets this CPU supports, narrowest first: those of AMPM_ISA_AVX2 and
+/// AMPM_ISA_AVX512 that `ampm_set_isa` accepts (AMPM_ERR_INVALID_ARGUMENT = unsupported,
+/// skipped). The current choice is restored before returning.
+inline std::vector<std::uint32_t> simd_isas() {
+  const IsaRestore keep;
+  std::vector<std::uint32_t> out;
+  for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX2}, std::uint32_t{AMPM_ISA_AVX512}})
+    if (ampm_set_isa(isa) == AMPM_OK) out.push_back(isa);
+  return out;
+}
 
 // ---- random numbers ------------------------------------------------------------------------
 

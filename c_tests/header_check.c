@@ -23,6 +23,7 @@ AMPM_CHECK(overflow, AMPM_ERR_OVERFLOW == 4);
 AMPM_CHECK(invalid_argument, AMPM_ERR_INVALID_ARGUMENT == 5);
 AMPM_CHECK(not_converged, AMPM_ERR_NOT_CONVERGED == 6);
 AMPM_CHECK(internal, AMPM_ERR_INTERNAL == 7);
+AMPM_CHECK(not_prepared, AMPM_ERR_NOT_PREPARED == 8);
 
 /* Prototypes of one scalar type T, suffix S, for both dimensions. */
 #define AMPM_TABLE_MEMBERS(T, S)                                                              \

@@ -19,6 +19,10 @@
  *        (d-term dot products, d×d products, one SVD sweep per pair of columns, scalings).
  * A wrong formula leaves residuals of the order of S itself, i.e. 1/(c·ε·κ) ≈ 10¹³ (f64)
  * or 10⁴ (f32) times the tolerance for the well-conditioned F used here (κ ≤ 4).
+ *
+ * Batch calls run on every instruction set of the CPU (ampm_set_isa): on the scalar one bit
+ * for bit equal to the single calls; on the SIMD ones (fused multiply-add) bit-identical to
+ * each other and within 2·c·ε·κ·S of the single calls (see test_batch in the body).
  */
 /* <stddef.h>/<stdint.h> first: whether ampm.h is self-contained is checked by the header_c99
  * test, not a reason for this test to stop compiling. */
@@ -59,6 +63,7 @@ static const char *status_name(AmpmStatus s) {
   case AMPM_ERR_INVALID_ARGUMENT: return "AMPM_ERR_INVALID_ARGUMENT";
   case AMPM_ERR_NOT_CONVERGED: return "AMPM_ERR_NOT_CONVERGED";
   case AMPM_ERR_INTERNAL: return "AMPM_ERR_INTERNAL";
+  case AMPM_ERR_NOT_PREPARED: return "AMPM_ERR_NOT_PREPARED";
   }
   return "(unknown status)";
 }
@@ -142,6 +147,30 @@ static struct geo geo_of(const ld *f, int d) {
 }
 
 #define TOL_OPS(d) (8.0L * (ld)(d) * (ld)(d))
+
+/* ---- instruction sets of the batch calls ------------------------------------------------ */
+
+static const char *isa_name(uint32_t isa) {
+  switch (isa) {
+  case AMPM_ISA_SCALAR: return "scalar";
+  case AMPM_ISA_AVX2: return "AVX2";
+  case AMPM_ISA_AVX512: return "AVX-512";
+  }
+  return "(unknown ISA)";
+}
+
+/* Fills isas[0..n) with AMPM_ISA_SCALAR followed by the SIMD sets ampm_set_isa accepts on this
+ * CPU (AMPM_ERR_INVALID_ARGUMENT = unsupported, skipped), narrowest first; returns n. The
+ * current choice is restored. */
+static int supported_isas(uint32_t isas[3]) {
+  const uint32_t prev = ampm_isa();
+  int n = 0;
+  isas[n++] = AMPM_ISA_SCALAR;
+  if (ampm_set_isa(AMPM_ISA_AVX2) == AMPM_OK) isas[n++] = AMPM_ISA_AVX2;
+  if (ampm_set_isa(AMPM_ISA_AVX512) == AMPM_OK) isas[n++] = AMPM_ISA_AVX512;
+  CHECK_STATUS(ampm_set_isa(prev), AMPM_OK);
+  return n;
+}
 
 /* ---- instantiations ------------------------------------------------------------------- */
 

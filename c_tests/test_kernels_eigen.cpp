@@ -9,10 +9,16 @@
 // Acceptance (issue 2): relative error ≤ 1e-11 in f64 and ≤ 1e-4 in f32, i.e. 4.5·10⁴ ε₆₄ and
 // 8.4·10² ε₃₂. "Relative" is the Frobenius norm of the error over the Frobenius norm of the
 // reference result, except for Ψ̂ (see `psi_scale`).
+//
+// Batch calls run on every instruction set of the CPU (`ampm_set_isa`): on AMPM_ISA_SCALAR bit
+// for bit equal to the single calls, on the SIMD sets bit-identical to each other and within
+// twice the acceptance of the single calls (see `kBatchVsSingle`). `check_isa_api` tests
+// ampm_set_isa / ampm_isa themselves.
 #include "common.hpp"
 
 #include <algorithm>
 #include <cinttypes>
+#include <cstdint>
 #include <vector>
 
 using namespace ampm_test;
@@ -68,6 +74,19 @@ struct Worst {
     }
   }
 };
+
+/// Bound on a SIMD batch result against the single call, in units of ε·scale (scale: the one
+/// its accuracy is measured against, 2μ‖F̂‖‖𝓑‖ for Â, ‖Ĉ:Z‖ for Ĉ:Z). Both run the same
+/// generic source, ~10³ operations per particle; they differ only in whether a·b + c is
+/// rounded once (fused, SIMD batch) or twice (scalar single call), ≤ 1 ulp per operation,
+/// amplified by at most the conditioning the accuracy bound already allows for. So the bound is
+/// derived from that bound, not measured: the batch and the single call each meet
+/// ‖x − ref‖ ≤ K·ε·scale with K = Accept<T>::tol/ε (4.5·10⁴ in f64, 8.4·10² in f32, the
+/// acceptance of issue 2; both are checked above), hence ‖batch − single‖ ≤ 2K·ε·scale.
+template <class T>
+constexpr ld kBatchVsSingle() {
+  return 2 * Accept<T>::tol / static_cast<ld>(std::numeric_limits<T>::epsilon());
+}
 
 // ---- finite differences (formula-free check of the reference) -----------------------------
 
@@ -143,6 +162,8 @@ struct Suite {
   std::vector<T> mu, f, z, ahat1, chat1;
   std::vector<ML> ahat_ref, chat_ref;
   std::vector<ld> ahat_scale;  // ahat_backward_scale per sample
+  // worst SIMD |batch − single|/(ε·scale) over every batch test: [0] Â, [1] Ĉ:Z
+  Worst worst_simd[2];
 
   Suite(Checker& c, std::uint64_t seed, int samples)
       : ck(c), rng(seed), n(samples), mu(n), f(n * DD), z(n * DD), ahat1(n * DD),
@@ -250,40 +271,92 @@ struct Suite {
 
     batch_all_valid();
     batch_failures();
+    std::printf("  SIMD batch vs single, worst |diff|/(eps * scale): ahat %.3Lf (%d)  chat_z "
+                "%.3Lf (%d)  (bound 2K = %.0Lf)\n",
+                worst_simd[0].value, worst_simd[0].sample, worst_simd[1].value,
+                worst_simd[1].sample, kBatchVsSingle<T>());
   }
 
   // ---- batch calls ----------------------------------------------------------------------
 
-  /// Compares batch outputs with the single calls, bit for bit, and with the reference.
+  /// Compares batch outputs, computed on instruction set `isa`, with the single calls and
+  /// with the reference:
+  ///  - AMPM_ISA_SCALAR runs the single calls' code (no FMA): bit for bit;
+  ///  - a SIMD set (FMA): within kBatchVsSingle·ε·scale of the single call (see there), and
+  ///    bit-identical to the batch of the first SIMD set (`simd_first`: filled by the first
+  ///    SIMD run of this batch, compared against by the others).
   void compare_batch(const std::vector<T>& out, const std::vector<T>& single,
                      const std::vector<ML>& ref, const char* what, int count,
-                     const std::vector<bool>& failed, const std::vector<ld>* scale) {
+                     const std::vector<bool>& failed, const std::vector<ld>* scale,
+                     std::uint32_t isa, std::vector<T>& simd_first) {
     int mismatched = 0, first_mismatch = -1;
     std::uint64_t max_ulps = 0;
-    Worst w;
+    Worst w, w_simd;
+    const bool scalar = isa == AMPM_ISA_SCALAR;
+    const ld eps = std::numeric_limits<T>::epsilon();
     for (int p = 0; p < count; ++p) {
       if (failed[p]) {
         AMPM_CHECK(ck, all_sentinel(out.data() + p * DD, DD),
-                   "%s %s: failed particle %d was written", A::name, what, p);
+                   "%s %s (%s): failed particle %d was written", A::name, what, isa_name(isa), p);
         continue;
       }
-      if (!same_bits(out.data() + p * DD, single.data() + p * DD, DD)) {
-        if (mismatched++ == 0) first_mismatch = p;
-        for (int k = 0; k < DD; ++k)
-          max_ulps = std::max(max_ulps, ulp_distance(out[p * DD + k], single[p * DD + k]));
-      }
       // Â against its natural scale (see ahat_backward_scale), Ĉ:Z relative to itself.
-      const ld e = scale ? (to_ld<T, D>(mat(out, p)) - ref[p]).norm() / (*scale)[p]
-                         : rel_err<T, D>(mat(out, p), ref[p]);
-      w.add(e, p);
+      const ld s = scale ? (*scale)[p] : ref[p].norm();
+      if (scalar) {
+        if (!same_bits(out.data() + p * DD, single.data() + p * DD, DD)) {
+          if (mismatched++ == 0) first_mismatch = p;
+          for (int k = 0; k < DD; ++k)
+            max_ulps = std::max(max_ulps, ulp_distance(out[p * DD + k], single[p * DD + k]));
+        }
+      } else {
+        const ld diff = (to_ld<T, D>(mat(out, p)) - to_ld<T, D>(mat(single, p))).norm();
+        w_simd.add(diff / (eps * s), p);
+      }
+      w.add((to_ld<T, D>(mat(out, p)) - ref[p]).norm() / s, p);
     }
-    AMPM_CHECK(ck, mismatched == 0,
-               "%s %s: %d of %d valid particles differ from the single call (first: %d, max "
-               "%" PRIu64 " ulps)",
-               A::name, what, mismatched, count, first_mismatch, max_ulps);
-    if (mismatched > 0 && first_mismatch >= 0) report_input(first_mismatch);
-    AMPM_CHECK(ck, w.value <= Accept<T>::tol, "%s %s: relative error %.3Le > %.0Le (particle %d)",
-               A::name, what, w.value, Accept<T>::tol, w.sample);
+    if (scalar) {
+      AMPM_CHECK(ck, mismatched == 0,
+                 "%s %s (scalar ISA): %d of %d valid particles differ from the single call "
+                 "(first: %d, max %" PRIu64 " ulps)",
+                 A::name, what, mismatched, count, first_mismatch, max_ulps);
+      if (mismatched > 0 && first_mismatch >= 0) report_input(first_mismatch);
+    } else {
+      const ld bound = kBatchVsSingle<T>();
+      AMPM_CHECK(ck, w_simd.value <= bound,
+                 "%s %s (%s): |batch - single| = %.3Lf eps * scale > %.0Lf (particle %d)",
+                 A::name, what, isa_name(isa), w_simd.value, bound, w_simd.sample);
+      if (!(w_simd.value <= bound) && w_simd.sample >= 0) report_input(w_simd.sample);
+      worst_simd[scale ? 0 : 1].add(w_simd.value, w_simd.sample);
+      if (simd_first.empty()) {
+        simd_first = out;
+      } else {
+        int differ = 0, first_differ = -1;
+        for (int p = 0; p < count; ++p)
+          if (!same_bits(out.data() + p * DD, simd_first.data() + p * DD, DD) &&
+              differ++ == 0)
+            first_differ = p;
+        AMPM_CHECK(ck, differ == 0,
+                   "%s %s: %d of %d particles differ between the SIMD instruction sets (%s vs "
+                   "the first; first: %d)",
+                   A::name, what, differ, count, isa_name(isa), first_differ);
+      }
+    }
+    AMPM_CHECK(ck, w.value <= Accept<T>::tol,
+               "%s %s (%s): relative error %.3Le > %.0Le (particle %d)", A::name, what,
+               isa_name(isa), w.value, Accept<T>::tol, w.sample);
+  }
+
+  /// The instruction sets every batch test runs on: scalar, then each SIMD set of this CPU.
+  static std::vector<std::uint32_t> batch_isas() {
+    std::vector<std::uint32_t> isas{AMPM_ISA_SCALAR};
+    for (std::uint32_t isa : simd_isas()) isas.push_back(isa);
+    return isas;
+  }
+
+  /// Sets `isa` for the batch calls (restored by the caller's IsaRestore).
+  void use_isa(std::uint32_t isa) {
+    AMPM_CHECK_STATUS(ck, ampm_set_isa(isa), AMPM_OK);
+    AMPM_CHECK(ck, ampm_isa() == isa, "ampm_isa() = %u after ampm_set_isa(%u)", ampm_isa(), isa);
   }
 
   AmpmStatus call_batch(bool chat, std::size_t count, const T* m, const T* ff, const T* zz,
@@ -296,14 +369,21 @@ struct Suite {
     const std::vector<bool> none(n, false);
     for (bool chat : {false, true}) {
       const char* what = chat ? "chat_z_batch" : "ahat_batch";
-      std::vector<T> out(n * DD, sentinel<T>());
-      std::size_t ff = 999'999;
-      AMPM_CHECK_STATUS(ck, call_batch(chat, n, mu.data(), f.data(), z.data(), out.data(), &ff),
-                        AMPM_OK);
-      AMPM_CHECK(ck, ff == static_cast<std::size_t>(n), "%s %s: first_failed = %zu, want n = %d",
-                 A::name, what, ff, n);
-      compare_batch(out, chat ? chat1 : ahat1, chat ? chat_ref : ahat_ref, what, n, none,
-                    chat ? nullptr : &ahat_scale);
+      std::vector<T> simd_first;
+      for (std::uint32_t isa : batch_isas()) {
+        const IsaRestore keep;
+        use_isa(isa);
+        std::vector<T> out(n * DD, sentinel<T>());
+        std::size_t ff = 999'999;
+        AMPM_CHECK_STATUS(ck,
+                          call_batch(chat, n, mu.data(), f.data(), z.data(), out.data(), &ff),
+                          AMPM_OK);
+        AMPM_CHECK(ck, ff == static_cast<std::size_t>(n),
+                   "%s %s (%s): first_failed = %zu, want n = %d", A::name, what, isa_name(isa),
+                   ff, n);
+        compare_batch(out, chat ? chat1 : ahat1, chat ? chat_ref : ahat_ref, what, n, none,
+                      chat ? nullptr : &ahat_scale, isa, simd_first);
+      }
     }
   }
 
@@ -348,19 +428,24 @@ struct Suite {
           }
         }
         // With inf Z ignored (Â), the expected first failure is unchanged in every case above.
-        std::vector<T> out(m * DD, sentinel<T>());
-        std::size_t ff = 999'999;
-        const AmpmStatus st = call_batch(chat, m, mb.data(), fb.data(), zb.data(), out.data(),
-                                         c.null_first_failed ? nullptr : &ff);
         const char* what = chat ? "chat_z_batch" : "ahat_batch";
-        AMPM_CHECK(ck, st == c.want, "%s %s [%s]: status %s, want %s", A::name, what, c.name,
-                   status_name(st), status_name(c.want));
-        if (!c.null_first_failed)
-          AMPM_CHECK(ck, ff == static_cast<std::size_t>(c.want_index),
-                     "%s %s [%s]: first_failed = %zu, want %d", A::name, what, c.name, ff,
-                     c.want_index);
-        compare_batch(out, chat ? chat1 : ahat1, chat ? chat_ref : ahat_ref, what, m, failed,
-                    chat ? nullptr : &ahat_scale);
+        std::vector<T> simd_first;
+        for (std::uint32_t isa : batch_isas()) {
+          const IsaRestore keep;
+          use_isa(isa);
+          std::vector<T> out(m * DD, sentinel<T>());
+          std::size_t ff = 999'999;
+          const AmpmStatus st = call_batch(chat, m, mb.data(), fb.data(), zb.data(), out.data(),
+                                           c.null_first_failed ? nullptr : &ff);
+          AMPM_CHECK(ck, st == c.want, "%s %s [%s] (%s): status %s, want %s", A::name, what,
+                     c.name, isa_name(isa), status_name(st), status_name(c.want));
+          if (!c.null_first_failed)
+            AMPM_CHECK(ck, ff == static_cast<std::size_t>(c.want_index),
+                       "%s %s [%s] (%s): first_failed = %zu, want %d", A::name, what, c.name,
+                       isa_name(isa), ff, c.want_index);
+          compare_batch(out, chat ? chat1 : ahat1, chat ? chat_ref : ahat_ref, what, m, failed,
+                        chat ? nullptr : &ahat_scale, isa, simd_first);
+        }
       }
       // n = 0 with NULL arrays: AMPM_OK and *first_failed = 0.
       std::size_t ff = 999'999;
@@ -378,10 +463,48 @@ struct Suite {
   }
 };
 
+/// ampm_set_isa / ampm_isa: the default is the widest instruction set this CPU supports;
+/// every supported set can be chosen and is then reported by ampm_isa(); an unknown or
+/// unsupported value is refused with AMPM_ERR_INVALID_ARGUMENT and changes nothing. Runs
+/// first, before any call has changed the default, and leaves the choice as it found it.
+void check_isa_api(Checker& ck) {
+  const std::uint32_t initial = ampm_isa();
+  const std::vector<std::uint32_t> simd = simd_isas();
+  AMPM_CHECK(ck, ampm_isa() == initial, "probing the ISAs changed ampm_isa() from %u to %u",
+             initial, ampm_isa());
+  const std::uint32_t widest = simd.empty() ? std::uint32_t{AMPM_ISA_SCALAR} : simd.back();
+  AMPM_CHECK(ck, initial == widest, "default ampm_isa() = %u (%s), want the widest, %u (%s)",
+             initial, isa_name(initial), widest, isa_name(widest));
+  std::printf("instruction sets: default %s; SIMD sets of this CPU:", isa_name(initial));
+  for (std::uint32_t isa : simd) std::printf(" %s", isa_name(isa));
+  std::printf("%s\n", simd.empty() ? " none" : "");
+
+  const IsaRestore keep;
+  std::vector<std::uint32_t> all{AMPM_ISA_SCALAR};
+  all.insert(all.end(), simd.begin(), simd.end());
+  for (std::uint32_t isa : all) {
+    AMPM_CHECK_STATUS(ck, ampm_set_isa(isa), AMPM_OK);
+    AMPM_CHECK(ck, ampm_isa() == isa, "ampm_isa() = %u after ampm_set_isa(%u)", ampm_isa(), isa);
+    for (std::uint32_t bad : {std::uint32_t{3}, std::uint32_t{99}, UINT32_MAX}) {
+      AMPM_CHECK_STATUS(ck, ampm_set_isa(bad), AMPM_ERR_INVALID_ARGUMENT);
+      AMPM_CHECK(ck, ampm_isa() == isa, "ampm_set_isa(%u) changed ampm_isa() from %u to %u", bad,
+                 isa, ampm_isa());
+    }
+    // A known but unsupported SIMD set is refused the same way.
+    for (std::uint32_t other : {std::uint32_t{AMPM_ISA_AVX2}, std::uint32_t{AMPM_ISA_AVX512}}) {
+      if (std::find(simd.begin(), simd.end(), other) != simd.end()) continue;
+      AMPM_CHECK_STATUS(ck, ampm_set_isa(other), AMPM_ERR_INVALID_ARGUMENT);
+      AMPM_CHECK(ck, ampm_isa() == isa, "ampm_set_isa(%u) (unsupported) changed ampm_isa()",
+                 other);
+    }
+  }
+}
+
 }  // namespace
 
 int main() {
   Checker ck;
+  check_isa_api(ck);
   // One seed per suite, derived from the base seed, so suites are independent of each other.
   Suite<double, 2>(ck, kSeed + 1, kSamples).run();
   Suite<double, 3>(ck, kSeed + 2, kSamples).run();

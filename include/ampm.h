@@ -20,7 +20,8 @@
 #define AMPM_METHOD_DEFAULT 0
 
 /**
- * `AmpmOptions::method`: one-sided (Hestenes) Jacobi on F, 3D; `max_iterations` caps sweeps.
+ * `AmpmOptions::method`: one-sided (Hestenes) Jacobi on F, 3D; `max_iterations` sets the
+ * number of sweeps.
  */
 #define AMPM_METHOD_ONE_SIDED_JACOBI 1
 
@@ -114,6 +115,21 @@
 #define AMPM_PHASE_LIQUID 1
 
 /**
+ * `ampm_set_isa` / `ampm_isa`: one particle per lane, no SIMD (every CPU).
+ */
+#define AMPM_ISA_SCALAR 0
+
+/**
+ * `ampm_set_isa` / `ampm_isa`: x86-64 AVX2 + FMA, 16 f32 or 8 f64 particles per step.
+ */
+#define AMPM_ISA_AVX2 1
+
+/**
+ * `ampm_set_isa` / `ampm_isa`: x86-64 AVX-512F, 32 f32 or 16 f64 particles per step.
+ */
+#define AMPM_ISA_AVX512 2
+
+/**
  * Result of every `ampm_*` call. `AMPM_OK` is 0; every error has its own non-zero value.
  *
  * On any status other than `AMPM_OK`, a single-particle call has written nothing; a batch
@@ -152,6 +168,11 @@ typedef enum {
    * An internal error was caught at the ABI boundary (a bug: please report it).
    */
   AMPM_ERR_INTERNAL = 7,
+  /**
+   * A prepared-Hessian slot that no successful `ampm_hessian_prepare_batch_*` wrote
+   * (zero-filled memory, or the slot of a particle whose prepare failed).
+   */
+  AMPM_ERR_NOT_PREPARED = 8,
 } AmpmStatus;
 
 /**
@@ -170,11 +191,11 @@ typedef struct {
    */
   uint32_t sweeps;
   /**
-   * Iteration cap of `AMPM_METHOD_ONE_SIDED_JACOBI` (sweeps, default 12), `AMPM_METHOD_QR`
-   * (QR sweeps, default 32), `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per
-   * eigen-solve, default 16): 0 (default) or 1..=1000. Reaching it without convergence is
-   * `AMPM_ERR_NOT_CONVERGED` (QR, Higham–Noferini); one-sided Jacobi returns its last
-   * iterate.
+   * Sweeps of `AMPM_METHOD_ONE_SIDED_JACOBI` (a fixed count, no stopping test; default 4
+   * in f32, 5 in f64), iteration cap of `AMPM_METHOD_QR` (QR sweeps, default 32) and of
+   * `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per eigen-solve, default 16): 0 (default)
+   * or 1..=1000. Reaching a cap without convergence is `AMPM_ERR_NOT_CONVERGED` (QR,
+   * Higham–Noferini).
    */
   uint32_t max_iterations;
 } AmpmOptions;
@@ -1914,6 +1935,330 @@ AmpmStatus ampm_pressure_3d_f64(size_t n,
                                 double *pressure,
                                 double *coefficient,
                                 size_t *first_failed);
+
+/**
+ * Chooses the instruction set of every batch call (`AMPM_ISA_*`); by default the widest the
+ * CPU supports, detected on first use.
+ *
+ * Returns `AMPM_ERR_INVALID_ARGUMENT` (and changes nothing) for a value this CPU does not
+ * support. Results are identical on the AVX2 and AVX-512 paths; the scalar path agrees with
+ * them to a few ulps times the conditioning of F. Call it before starting threads that use
+ * the library (the choice is one process-wide value).
+ */
+AmpmStatus ampm_set_isa(uint32_t isa);
+
+/**
+ * The instruction set the batch calls use (`AMPM_ISA_*`).
+ */
+uint32_t ampm_isa(void);
+
+/**
+ * Computes Â and Ĉ:Z of n particles with one decomposition each: `ahat[i]` = Â(mu[i], F[i]),
+ * `chat_z[i]` = Ĉ(mu[i], F[i]):Z[i] (fixed corotated Ψ̂, a = -1/2, default decomposition).
+ *
+ * `mu`: n shear moduli (Pa, ≥ 0; 0 is a liquid: both outputs 0); `f`, `z`, `ahat`,
+ * `chat_z`: n 2×2 column-major matrices back to back (4 scalars each). `ahat` (Pa) or
+ * `chat_z` (Pa per unit strain) may be NULL: that output is not computed, and `z` may be NULL
+ * when `chat_z` is; both NULL is `AMPM_ERR_NULL_POINTER` when n > 0. Every valid particle is
+ * computed; a failed particle leaves both outputs untouched. Returns the first failure's
+ * status (`AMPM_ERR_NON_FINITE`, `AMPM_ERR_NON_POSITIVE_J`, `AMPM_ERR_INVALID_ARGUMENT` for
+ * mu < 0, `AMPM_ERR_OVERFLOW`) and writes its index (n if none) to `first_failed` (may be
+ * NULL; not written on a whole-call error such as a NULL array). Outputs may alias `f` or
+ * `z` exactly (in place). A particle's result does not depend on n or on its index.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_ahat_chat_z_batch_2d_f32(size_t n,
+                                         const float *mu,
+                                         const float *f,
+                                         const float *z,
+                                         float *ahat,
+                                         float *chat_z,
+                                         size_t *first_failed);
+
+/**
+ * Scalars (18) of one particle's prepared-Hessian slot for
+ * `ampm_hessian_prepare_batch_2d_f32` / `ampm_hessian_apply_batch_2d_f32`.
+ */
+size_t ampm_hessian_len_2d_f32(void);
+
+/**
+ * Prepares the Hessian Ĉ of n particles once (per Newton step) for any number of
+ * `ampm_hessian_apply_batch_2d_f32` calls, and optionally computes Â.
+ *
+ * `mu`: n values (Pa, ≥ 0); `f`: n 2×2 column-major matrices; `ahat`: n matrices or NULL
+ * (not computed); `prepared`: n slots of `ampm_hessian_len_2d_f32()` = 18 scalars, slot i
+ * at `prepared + i·18`, opaque. The slot holds the decomposition and the SVD-basis
+ * eigenvalues of Ĉ and of its PSD projection Ĉ⁺, so apply can give either. A failed
+ * particle leaves `ahat[i]` untouched and marks slot i unprepared (only its first scalar is
+ * written), so that a later apply refuses it (`AMPM_ERR_NOT_PREPARED`) instead of using data
+ * from an earlier step. Statuses and `first_failed` as `ampm_ahat_chat_z_batch_2d_f32`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above; `prepared` must not overlap the
+ * inputs.
+ */
+AmpmStatus ampm_hessian_prepare_batch_2d_f32(size_t n,
+                                             const float *mu,
+                                             const float *f,
+                                             float *ahat,
+                                             float *prepared,
+                                             size_t *first_failed);
+
+/**
+ * Applies prepared Hessians: `out[i]` = Ĉ:Z[i], or the PSD-projected Ĉ⁺:Z[i] when `psd` ≠ 0
+ * (Pa per unit strain), without any decomposition.
+ *
+ * `prepared`: n slots written by `ampm_hessian_prepare_batch_2d_f32` (18 scalars each);
+ * `z`, `out`: n 2×2 column-major matrices (`out` may alias `z` exactly). A slot that no
+ * successful prepare wrote (zero-filled memory, or the slot of a failed particle) gives
+ * `AMPM_ERR_NOT_PREPARED` for that particle; a non-finite Z gives `AMPM_ERR_NON_FINITE`, an
+ * unrepresentable result `AMPM_ERR_OVERFLOW`. Failed particles leave `out` untouched; the
+ * first failure's status is returned and its index (n if none) written to `first_failed`
+ * (may be NULL). The result agrees with `ampm_chat_z_batch_2d_f32` (or
+ * `ampm_chat_z_psd_batch_2d_f32`) on the same instruction set to a few ulps.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_hessian_apply_batch_2d_f32(size_t n,
+                                           const float *prepared,
+                                           const float *z,
+                                           float *out,
+                                           int psd,
+                                           size_t *first_failed);
+
+/**
+ * Computes Â and Ĉ:Z of n particles with one decomposition each: `ahat[i]` = Â(mu[i], F[i]),
+ * `chat_z[i]` = Ĉ(mu[i], F[i]):Z[i] (fixed corotated Ψ̂, a = -1/2, default decomposition).
+ *
+ * `mu`: n shear moduli (Pa, ≥ 0; 0 is a liquid: both outputs 0); `f`, `z`, `ahat`,
+ * `chat_z`: n 2×2 column-major matrices back to back (4 scalars each). `ahat` (Pa) or
+ * `chat_z` (Pa per unit strain) may be NULL: that output is not computed, and `z` may be NULL
+ * when `chat_z` is; both NULL is `AMPM_ERR_NULL_POINTER` when n > 0. Every valid particle is
+ * computed; a failed particle leaves both outputs untouched. Returns the first failure's
+ * status (`AMPM_ERR_NON_FINITE`, `AMPM_ERR_NON_POSITIVE_J`, `AMPM_ERR_INVALID_ARGUMENT` for
+ * mu < 0, `AMPM_ERR_OVERFLOW`) and writes its index (n if none) to `first_failed` (may be
+ * NULL; not written on a whole-call error such as a NULL array). Outputs may alias `f` or
+ * `z` exactly (in place). A particle's result does not depend on n or on its index.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_ahat_chat_z_batch_2d_f64(size_t n,
+                                         const double *mu,
+                                         const double *f,
+                                         const double *z,
+                                         double *ahat,
+                                         double *chat_z,
+                                         size_t *first_failed);
+
+/**
+ * Scalars (18) of one particle's prepared-Hessian slot for
+ * `ampm_hessian_prepare_batch_2d_f64` / `ampm_hessian_apply_batch_2d_f64`.
+ */
+size_t ampm_hessian_len_2d_f64(void);
+
+/**
+ * Prepares the Hessian Ĉ of n particles once (per Newton step) for any number of
+ * `ampm_hessian_apply_batch_2d_f64` calls, and optionally computes Â.
+ *
+ * `mu`: n values (Pa, ≥ 0); `f`: n 2×2 column-major matrices; `ahat`: n matrices or NULL
+ * (not computed); `prepared`: n slots of `ampm_hessian_len_2d_f64()` = 18 scalars, slot i
+ * at `prepared + i·18`, opaque. The slot holds the decomposition and the SVD-basis
+ * eigenvalues of Ĉ and of its PSD projection Ĉ⁺, so apply can give either. A failed
+ * particle leaves `ahat[i]` untouched and marks slot i unprepared (only its first scalar is
+ * written), so that a later apply refuses it (`AMPM_ERR_NOT_PREPARED`) instead of using data
+ * from an earlier step. Statuses and `first_failed` as `ampm_ahat_chat_z_batch_2d_f64`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above; `prepared` must not overlap the
+ * inputs.
+ */
+AmpmStatus ampm_hessian_prepare_batch_2d_f64(size_t n,
+                                             const double *mu,
+                                             const double *f,
+                                             double *ahat,
+                                             double *prepared,
+                                             size_t *first_failed);
+
+/**
+ * Applies prepared Hessians: `out[i]` = Ĉ:Z[i], or the PSD-projected Ĉ⁺:Z[i] when `psd` ≠ 0
+ * (Pa per unit strain), without any decomposition.
+ *
+ * `prepared`: n slots written by `ampm_hessian_prepare_batch_2d_f64` (18 scalars each);
+ * `z`, `out`: n 2×2 column-major matrices (`out` may alias `z` exactly). A slot that no
+ * successful prepare wrote (zero-filled memory, or the slot of a failed particle) gives
+ * `AMPM_ERR_NOT_PREPARED` for that particle; a non-finite Z gives `AMPM_ERR_NON_FINITE`, an
+ * unrepresentable result `AMPM_ERR_OVERFLOW`. Failed particles leave `out` untouched; the
+ * first failure's status is returned and its index (n if none) written to `first_failed`
+ * (may be NULL). The result agrees with `ampm_chat_z_batch_2d_f64` (or
+ * `ampm_chat_z_psd_batch_2d_f64`) on the same instruction set to a few ulps.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_hessian_apply_batch_2d_f64(size_t n,
+                                           const double *prepared,
+                                           const double *z,
+                                           double *out,
+                                           int psd,
+                                           size_t *first_failed);
+
+/**
+ * Computes Â and Ĉ:Z of n particles with one decomposition each: `ahat[i]` = Â(mu[i], F[i]),
+ * `chat_z[i]` = Ĉ(mu[i], F[i]):Z[i] (fixed corotated Ψ̂, a = -1/3, default decomposition).
+ *
+ * `mu`: n shear moduli (Pa, ≥ 0; 0 is a liquid: both outputs 0); `f`, `z`, `ahat`,
+ * `chat_z`: n 3×3 column-major matrices back to back (9 scalars each). `ahat` (Pa) or
+ * `chat_z` (Pa per unit strain) may be NULL: that output is not computed, and `z` may be NULL
+ * when `chat_z` is; both NULL is `AMPM_ERR_NULL_POINTER` when n > 0. Every valid particle is
+ * computed; a failed particle leaves both outputs untouched. Returns the first failure's
+ * status (`AMPM_ERR_NON_FINITE`, `AMPM_ERR_NON_POSITIVE_J`, `AMPM_ERR_INVALID_ARGUMENT` for
+ * mu < 0, `AMPM_ERR_OVERFLOW`) and writes its index (n if none) to `first_failed` (may be
+ * NULL; not written on a whole-call error such as a NULL array). Outputs may alias `f` or
+ * `z` exactly (in place). A particle's result does not depend on n or on its index.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_ahat_chat_z_batch_3d_f32(size_t n,
+                                         const float *mu,
+                                         const float *f,
+                                         const float *z,
+                                         float *ahat,
+                                         float *chat_z,
+                                         size_t *first_failed);
+
+/**
+ * Scalars (38) of one particle's prepared-Hessian slot for
+ * `ampm_hessian_prepare_batch_3d_f32` / `ampm_hessian_apply_batch_3d_f32`.
+ */
+size_t ampm_hessian_len_3d_f32(void);
+
+/**
+ * Prepares the Hessian Ĉ of n particles once (per Newton step) for any number of
+ * `ampm_hessian_apply_batch_3d_f32` calls, and optionally computes Â.
+ *
+ * `mu`: n values (Pa, ≥ 0); `f`: n 3×3 column-major matrices; `ahat`: n matrices or NULL
+ * (not computed); `prepared`: n slots of `ampm_hessian_len_3d_f32()` = 38 scalars, slot i
+ * at `prepared + i·38`, opaque. The slot holds the decomposition and the SVD-basis
+ * eigenvalues of Ĉ and of its PSD projection Ĉ⁺, so apply can give either. A failed
+ * particle leaves `ahat[i]` untouched and marks slot i unprepared (only its first scalar is
+ * written), so that a later apply refuses it (`AMPM_ERR_NOT_PREPARED`) instead of using data
+ * from an earlier step. Statuses and `first_failed` as `ampm_ahat_chat_z_batch_3d_f32`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above; `prepared` must not overlap the
+ * inputs.
+ */
+AmpmStatus ampm_hessian_prepare_batch_3d_f32(size_t n,
+                                             const float *mu,
+                                             const float *f,
+                                             float *ahat,
+                                             float *prepared,
+                                             size_t *first_failed);
+
+/**
+ * Applies prepared Hessians: `out[i]` = Ĉ:Z[i], or the PSD-projected Ĉ⁺:Z[i] when `psd` ≠ 0
+ * (Pa per unit strain), without any decomposition.
+ *
+ * `prepared`: n slots written by `ampm_hessian_prepare_batch_3d_f32` (38 scalars each);
+ * `z`, `out`: n 3×3 column-major matrices (`out` may alias `z` exactly). A slot that no
+ * successful prepare wrote (zero-filled memory, or the slot of a failed particle) gives
+ * `AMPM_ERR_NOT_PREPARED` for that particle; a non-finite Z gives `AMPM_ERR_NON_FINITE`, an
+ * unrepresentable result `AMPM_ERR_OVERFLOW`. Failed particles leave `out` untouched; the
+ * first failure's status is returned and its index (n if none) written to `first_failed`
+ * (may be NULL). The result agrees with `ampm_chat_z_batch_3d_f32` (or
+ * `ampm_chat_z_psd_batch_3d_f32`) on the same instruction set to a few ulps.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_hessian_apply_batch_3d_f32(size_t n,
+                                           const float *prepared,
+                                           const float *z,
+                                           float *out,
+                                           int psd,
+                                           size_t *first_failed);
+
+/**
+ * Computes Â and Ĉ:Z of n particles with one decomposition each: `ahat[i]` = Â(mu[i], F[i]),
+ * `chat_z[i]` = Ĉ(mu[i], F[i]):Z[i] (fixed corotated Ψ̂, a = -1/3, default decomposition).
+ *
+ * `mu`: n shear moduli (Pa, ≥ 0; 0 is a liquid: both outputs 0); `f`, `z`, `ahat`,
+ * `chat_z`: n 3×3 column-major matrices back to back (9 scalars each). `ahat` (Pa) or
+ * `chat_z` (Pa per unit strain) may be NULL: that output is not computed, and `z` may be NULL
+ * when `chat_z` is; both NULL is `AMPM_ERR_NULL_POINTER` when n > 0. Every valid particle is
+ * computed; a failed particle leaves both outputs untouched. Returns the first failure's
+ * status (`AMPM_ERR_NON_FINITE`, `AMPM_ERR_NON_POSITIVE_J`, `AMPM_ERR_INVALID_ARGUMENT` for
+ * mu < 0, `AMPM_ERR_OVERFLOW`) and writes its index (n if none) to `first_failed` (may be
+ * NULL; not written on a whole-call error such as a NULL array). Outputs may alias `f` or
+ * `z` exactly (in place). A particle's result does not depend on n or on its index.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_ahat_chat_z_batch_3d_f64(size_t n,
+                                         const double *mu,
+                                         const double *f,
+                                         const double *z,
+                                         double *ahat,
+                                         double *chat_z,
+                                         size_t *first_failed);
+
+/**
+ * Scalars (38) of one particle's prepared-Hessian slot for
+ * `ampm_hessian_prepare_batch_3d_f64` / `ampm_hessian_apply_batch_3d_f64`.
+ */
+size_t ampm_hessian_len_3d_f64(void);
+
+/**
+ * Prepares the Hessian Ĉ of n particles once (per Newton step) for any number of
+ * `ampm_hessian_apply_batch_3d_f64` calls, and optionally computes Â.
+ *
+ * `mu`: n values (Pa, ≥ 0); `f`: n 3×3 column-major matrices; `ahat`: n matrices or NULL
+ * (not computed); `prepared`: n slots of `ampm_hessian_len_3d_f64()` = 38 scalars, slot i
+ * at `prepared + i·38`, opaque. The slot holds the decomposition and the SVD-basis
+ * eigenvalues of Ĉ and of its PSD projection Ĉ⁺, so apply can give either. A failed
+ * particle leaves `ahat[i]` untouched and marks slot i unprepared (only its first scalar is
+ * written), so that a later apply refuses it (`AMPM_ERR_NOT_PREPARED`) instead of using data
+ * from an earlier step. Statuses and `first_failed` as `ampm_ahat_chat_z_batch_3d_f64`.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above; `prepared` must not overlap the
+ * inputs.
+ */
+AmpmStatus ampm_hessian_prepare_batch_3d_f64(size_t n,
+                                             const double *mu,
+                                             const double *f,
+                                             double *ahat,
+                                             double *prepared,
+                                             size_t *first_failed);
+
+/**
+ * Applies prepared Hessians: `out[i]` = Ĉ:Z[i], or the PSD-projected Ĉ⁺:Z[i] when `psd` ≠ 0
+ * (Pa per unit strain), without any decomposition.
+ *
+ * `prepared`: n slots written by `ampm_hessian_prepare_batch_3d_f64` (38 scalars each);
+ * `z`, `out`: n 3×3 column-major matrices (`out` may alias `z` exactly). A slot that no
+ * successful prepare wrote (zero-filled memory, or the slot of a failed particle) gives
+ * `AMPM_ERR_NOT_PREPARED` for that particle; a non-finite Z gives `AMPM_ERR_NON_FINITE`, an
+ * unrepresentable result `AMPM_ERR_OVERFLOW`. Failed particles leave `out` untouched; the
+ * first failure's status is returned and its index (n if none) written to `first_failed`
+ * (may be NULL). The result agrees with `ampm_chat_z_batch_3d_f64` (or
+ * `ampm_chat_z_psd_batch_3d_f64`) on the same instruction set to a few ulps.
+ *
+ * # Safety
+ * Non-null pointers must be valid for the sizes above.
+ */
+AmpmStatus ampm_hessian_apply_batch_3d_f64(size_t n,
+                                           const double *prepared,
+                                           const double *z,
+                                           double *out,
+                                           int psd,
+                                           size_t *first_failed);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -4,7 +4,9 @@
 //!
 //! - Each error (NULL pointer, NaN/±inf in `F`, `Z`, `μ`, `det F ≤ 0`, `μ < 0`, overflow)
 //!   gives its own status, and the output buffer keeps its sentinel bit for bit.
-//! - Success gives the core API's result bit for bit, also in place (`out == F`, `out == Z`).
+//! - Success gives the core API's result bit for bit, also in place (`out == F`, `out == Z`):
+//!   single calls that of the scalar path of `ampm_core::kernel`, batch calls that of the
+//!   instruction set `ampm_isa()` reports.
 //! - Batch calls compute every valid particle, leave failed ones untouched, return the first
 //!   failure's status and index, accept a NULL `first_failed` and NULL arrays when `n = 0`,
 //!   and refuse an `n` whose byte size overflows without touching memory.
@@ -19,7 +21,9 @@
 
 use ampm::AmpmStatus::{self, *};
 use ampm_core::augmented;
-use ampm_core::energy::FixedCorotated;
+use ampm_core::kernel::batch::{self, BatchReal, Outputs};
+use ampm_core::kernel::{Dim, LaneDim};
+use ampm_core::lane::{Isa, IsaKind};
 use ampm_core::{Error, Mat, Matrix, Real};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -57,8 +61,56 @@ struct Api<T> {
 trait Abi: Matrix {
     const API: Api<Self::Scalar>;
     fn psi_hat(mu: Self::Scalar, f: &Self) -> Res<Self::Scalar>;
-    fn ahat(mu: Self::Scalar, f: &Self) -> Res<Self>;
-    fn chat_z(mu: Self::Scalar, f: &Self, z: &Self) -> Res<Self>;
+    fn ahat(isa: Isa, mu: Self::Scalar, f: &Self) -> Res<Self>;
+    fn chat_z(isa: Isa, mu: Self::Scalar, f: &Self, z: &Self) -> Res<Self>;
+}
+
+/// The instruction set the C batch calls use.
+fn c_isa() -> Isa {
+    Isa::available()
+        .into_iter()
+        .find(|i| {
+            let code = match i.kind() {
+                IsaKind::Scalar => ampm::AMPM_ISA_SCALAR,
+                IsaKind::Avx2 => ampm::AMPM_ISA_AVX2,
+                IsaKind::Avx512 => ampm::AMPM_ISA_AVX512,
+            };
+            code == ampm::ampm_isa()
+        })
+        .unwrap_or(Isa::SCALAR)
+}
+
+/// One output of the core batch kernels for one particle: 0 = Ψ̂, 1 = Â, 2 = Ĉ:Z.
+fn core_one<T: BatchReal, const D: usize>(
+    isa: Isa,
+    mu: T,
+    f: &Mat<T, D>,
+    z: &Mat<T, D>,
+    what: u8,
+) -> Res<Vec<T>>
+where
+    Dim<D>: LaneDim<D>,
+{
+    let fv = f.cols.concat();
+    let zv = z.cols.concat();
+    let mut out = vec![T::ZERO; if what == 0 { 1 } else { D * D }];
+    let o = match what {
+        0 => Outputs {
+            energy: Some(&mut out),
+            ..Outputs::default()
+        },
+        1 => Outputs {
+            ahat: Some(&mut out),
+            ..Outputs::default()
+        },
+        _ => Outputs {
+            chat_z: Some(&mut out),
+            ..Outputs::default()
+        },
+    };
+    let st = batch::ahat_chat_z::<T, D>(isa, &[mu], &fv, (what == 2).then_some(&zv[..]), o)?;
+    st.result().map_err(|e| e.1)?;
+    Ok(out)
 }
 
 macro_rules! impl_abi {
@@ -74,13 +126,13 @@ macro_rules! impl_abi {
                 chat_z_batch: ampm::$cb,
             };
             fn psi_hat(mu: $t, f: &Self) -> Res<$t> {
-                augmented::psi_hat(&FixedCorotated::new(mu), f)
+                core_one::<$t, $d>(Isa::SCALAR, mu, f, f, 0).map(|v| v[0])
             }
-            fn ahat(mu: $t, f: &Self) -> Res<Self> {
-                augmented::ahat(&FixedCorotated::new(mu), f)
+            fn ahat(isa: Isa, mu: $t, f: &Self) -> Res<Self> {
+                core_one::<$t, $d>(isa, mu, f, f, 1).map(|v| Mat::from_col_major(&v).unwrap())
             }
-            fn chat_z(mu: $t, f: &Self, z: &Self) -> Res<Self> {
-                augmented::chat_z(&FixedCorotated::new(mu), f, z)
+            fn chat_z(isa: Isa, mu: $t, f: &Self, z: &Self) -> Res<Self> {
+                core_one::<$t, $d>(isa, mu, f, z, 2).map(|v| Mat::from_col_major(&v).unwrap())
             }
         }
     };
@@ -181,12 +233,17 @@ unsafe fn call<M: Abi>(
 
 /// The core API's result of `op`, flattened column-major.
 fn reference<M: Abi>(op: Op, mu: M::Scalar, f: &M, z: &M) -> Res<Vec<M::Scalar>> {
+    reference_on(Isa::SCALAR, op, mu, f, z)
+}
+
+/// The core result of `op` on the instruction set `isa` (the batch calls run on [`c_isa`]).
+fn reference_on<M: Abi>(isa: Isa, op: Op, mu: M::Scalar, f: &M, z: &M) -> Res<Vec<M::Scalar>> {
     let m = match op {
         Op::BZ => augmented::b_z(f, z)?,
         Op::ZB => augmented::z_b(f, z)?,
         Op::Psi => return M::psi_hat(mu, f).map(|p| vec![p]),
-        Op::Ahat => M::ahat(mu, f)?,
-        Op::Chat => M::chat_z(mu, f, z)?,
+        Op::Ahat => M::ahat(isa, mu, f)?,
+        Op::Chat => M::chat_z(isa, mu, f, z)?,
     };
     Ok(m.to_array().as_ref().to_vec())
 }
@@ -669,7 +726,7 @@ fn check_batch<M: Abi>(
     let mut first = None;
     for (i, p) in ps.iter().enumerate() {
         let chunk = &out[i * M::LEN..(i + 1) * M::LEN];
-        match reference(op.single(), p.mu, &p.f, &p.z) {
+        match reference_on(c_isa(), op.single(), p.mu, &p.f, &p.z) {
             Ok(want) => assert_eq!(bits(chunk), bits(&want), "{op:?} particle {i} {p:?}"),
             Err(e) => {
                 assert_untouched::<M>(chunk, &(op, i, p));

@@ -11,9 +11,9 @@
 use ampm::methods::{
     ampm_ahat_batch_ex_3d_f64, ampm_ahat_ex_2d_f64, ampm_ahat_ex_3d_f32, ampm_ahat_ex_3d_f64,
     ampm_chat_z_batch_ex_3d_f64, ampm_chat_z_ex_3d_f64, ampm_energy_hat_ex_3d_f64,
-    ampm_polar_2d_f64, ampm_polar_3d_f64, ampm_svd_2d_f32, ampm_svd_3d_f32, ampm_svd_3d_f64,
-    AmpmOptions, AMPM_METHOD_CLOSED_FORM_2D, AMPM_METHOD_DEFAULT, AMPM_METHOD_HIGHAM_NOFERINI,
-    AMPM_METHOD_MCADAMS, AMPM_METHOD_ONE_SIDED_JACOBI, AMPM_METHOD_QR,
+    ampm_polar_2d_f32, ampm_polar_2d_f64, ampm_polar_3d_f64, ampm_svd_2d_f32, ampm_svd_3d_f32,
+    ampm_svd_3d_f64, AmpmOptions, AMPM_METHOD_CLOSED_FORM_2D, AMPM_METHOD_DEFAULT,
+    AMPM_METHOD_HIGHAM_NOFERINI, AMPM_METHOD_MCADAMS, AMPM_METHOD_ONE_SIDED_JACOBI, AMPM_METHOD_QR,
 };
 use ampm::AmpmStatus;
 use ampm_core::augmented;
@@ -91,38 +91,47 @@ contract_test!(contracts_2d_f64, f64, 2);
 contract_test!(contracts_2d_f32, f32, 2);
 
 /// The reference SVD reconstructs `F` and is orthonormal to double-double accuracy:
-/// `BOUND_RECON·ε_dd ≈ 1.3e-29` relative (the same backward-error bound as the f64 methods,
-/// in units of the double-double ε = 2⁻¹⁰⁴).
+/// [`stability::BOUND_REFERENCE`] `= BOUND_RECON·ε_dd ≈ 1.3e-29` (the same backward-error
+/// bound as the f64 methods, in units of the double-double ε = 2⁻¹⁰⁴), relative to
+/// `max(‖F‖, 2⁻⁹⁶⁹)` (below that the trailing word of a double-double is subnormal), in 2D and
+/// 3D, on the matrices of every finite family rounded to f64 and to f32. (The stability
+/// measurement checks the same at every case it uses.)
 #[test]
 fn reference_is_double_double_accurate() {
-    let tol = BOUND_RECON * Dd::EPSILON.to_f64();
-    let mut checked = 0;
-    // Every finite family except the subnormal one (below 2⁻⁹⁶⁹ the trailing word of a
-    // double-double is itself subnormal: fewer than 106 bits).
-    for fam in Family::ALL
-        .into_iter()
-        .filter(|f| !matches!(f, Family::NonFinite | Family::Subnormal))
+    fn check<T: Real, const D: usize>(failures: &mut Vec<String>) -> usize
+    where
+        reference::Dim<D>: reference::ReferenceDim<M = Mat<Dd, D>>,
+        Mat<f64, D>: ampm_tools::families::FamilyDim,
+        Mat<Dd, D>: Matrix<Scalar = Dd, Vector = [Dd; D]>,
     {
-        for case in generate::<f64, 3>(fam, Size::Reduced).iter().take(200) {
-            let svd = reference::svd::<3>(&case.f).expect("finite");
-            let fd = reference::to_dd(&case.f);
-            let rec = svd.reconstruct() - fd;
-            let nf = fd.norm_squared().sqrt().to_f64();
-            if nf == 0.0 {
-                continue;
+        let mut checked = 0;
+        for fam in Family::ALL.into_iter().filter(|f| *f != Family::NonFinite) {
+            for case in generate::<T, D>(fam, Size::Reduced).iter().take(200) {
+                let svd = reference::svd::<D>(&case.f).expect("finite");
+                if let Some(e) = stability::reference_error(&case.f, &svd) {
+                    failures.push(format!(
+                        "{D}D {} {fam:?} F = {:?}: {e}",
+                        T::NAME,
+                        case.f.cols
+                    ));
+                }
+                checked += 1;
             }
-            let e = rec.norm_squared().sqrt().to_f64() / nf;
-            assert!(e <= tol, "{fam:?}: reconstruction {e:e} > {tol:e}");
-            let id = Mat::<Dd, 3>::identity();
-            for q in [svd.u, svd.v] {
-                let o = (q.transpose() * q - id).max_abs().to_f64();
-                assert!(o <= tol, "{fam:?}: orthogonality {o:e}");
-                assert!(q.det() > Dd::ZERO);
-            }
-            checked += 1;
         }
+        checked
     }
-    assert!(checked > 1000, "{checked}");
+    let mut failures = Vec::new();
+    let checked = check::<f64, 3>(&mut failures)
+        + check::<f32, 3>(&mut failures)
+        + check::<f64, 2>(&mut failures)
+        + check::<f32, 2>(&mut failures);
+    assert!(
+        failures.is_empty(),
+        "{} of {checked} reference SVDs not accurate, e.g.:\n{}",
+        failures.len(),
+        failures[..failures.len().min(8)].join("\n")
+    );
+    assert!(checked > 4000, "{checked}");
 }
 
 /// Power-of-two scaling is exact, so every method must commute with it bit for bit: no
@@ -229,6 +238,67 @@ fn higham_noferini_is_rotation_variant_for_negative_det() {
     assert!(a.sigma[2] < 0.0 && b.sigma[2] < 0.0);
 }
 
+/// `F = c·I` plus one off-diagonal `±δ` whose square is subnormal or zero (`δ = 1e-22`,
+/// `1e-30` in f32; `1e-161`, `1e-162`, `1e-300` in f64), at either off-diagonal position: the
+/// 2D closed form normalises vectors like `(F₀₀ − F₁₁, F₀₁ + F₁₀) ≈ (0, δ/2)` (after scaling
+/// `F` to `[0.5, 1)`), and a norm taken as `√(x² + y²)` is off by up to tens of percent where
+/// `δ²/4` keeps only a few subnormal bits (f32 `1e-22`, f64 `1e-161`; at `1e-162` it
+/// underflows to zero). `U`, `V` must be rotations and `R = UVᵀ = I` (the exact `R` is a
+/// rotation by `~δ/(2c)`, far below ε) to `4ε` per entry, through the Rust method and through
+/// the C ABI's default 2D polar decomposition.
+#[test]
+fn closed_form_2d_square_underflow() {
+    type Polar<T> =
+        unsafe extern "C" fn(*const AmpmOptions, *const T, *mut T, *mut T) -> AmpmStatus;
+    fn check<T: Real>(deltas: &[f64], polar: Polar<T>) -> Vec<String> {
+        let eps = T::EPSILON.to_f64();
+        let id = Mat::<f64, 2>::identity();
+        let mut failures = Vec::new();
+        for c in [1.0, 0.7, 1.5] {
+            for delta in deltas.iter().flat_map(|&d| [d, -d]) {
+                for (i, j) in [(0, 1), (1, 0)] {
+                    let mut f = Mat::<f64, 2>::identity() * c;
+                    f.cols[j][i] = delta;
+                    let f = f.cast::<T>();
+                    let at = format!("{} c = {c}, F[{i}][{j}] = {delta:e}", T::NAME);
+                    let svd = ClosedForm2.svd(&f).expect("finite F");
+                    let (u, v) = (svd.u.cast::<f64>(), svd.v.cast::<f64>());
+                    let ou = (u.transpose() * u - id).max_abs();
+                    let ov = (v.transpose() * v - id).max_abs();
+                    let er = (svd.rotation().cast::<f64>() - id).max_abs();
+                    if ou > 4.0 * eps || ov > 4.0 * eps || er > 4.0 * eps {
+                        failures.push(format!(
+                            "{at}: |UᵀU − I| = {ou:e}, |VᵀV − I| = {ov:e}, |R − I| = {er:e} \
+                             (4ε = {:e})",
+                            4.0 * eps
+                        ));
+                    }
+                    let fc = f.cols.concat();
+                    let (mut r, mut s) = ([T::ZERO; 4], [T::ZERO; 4]);
+                    let st =
+                        unsafe { polar(ptr::null(), fc.as_ptr(), r.as_mut_ptr(), s.as_mut_ptr()) };
+                    let r = Mat::<T, 2>::from_col_major(&r)
+                        .expect("4 entries")
+                        .cast::<f64>();
+                    let er = (r - id).max_abs();
+                    if st != AmpmStatus::AMPM_OK || er > 4.0 * eps {
+                        failures.push(format!("{at}: C ABI polar: {st:?}, |R − I| = {er:e}"));
+                    }
+                }
+            }
+        }
+        failures
+    }
+    let mut failures = check::<f32>(&[1e-22, 1e-30], ampm_polar_2d_f32);
+    failures.extend(check::<f64>(&[1e-161, 1e-162, 1e-300], ampm_polar_2d_f64));
+    assert!(
+        failures.is_empty(),
+        "{} failures:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
 // --- C ABI: run-time method choice -------------------------------------------------------
 
 fn opts(method: u32, sweeps: u32, max_iterations: u32) -> AmpmOptions {
@@ -243,16 +313,28 @@ const F3: [f64; 9] = [1.2, 0.2, -0.3, 0.3, 0.8, 0.1, -0.1, 0.4, 1.5];
 const Z3: [f64; 9] = [0.3, 0.5, 0.9, -0.7, 0.1, 0.6, 0.2, -0.4, 0.2];
 
 /// Each `_ex` call equals, bit for bit, the Rust kernel with the same method chosen at
-/// compile time.
+/// compile time; with the default method (as the calls without `_ex`), the fast kernels of
+/// `ampm_core::kernel` on the scalar path.
 #[test]
 fn ffi_ex_matches_compile_time_methods() {
     let f = Mat::<f64, 3>::from_col_major(&F3).unwrap();
     let z = Mat::<f64, 3>::from_col_major(&Z3).unwrap();
     fn expect<S: SvdMethod<Mat<f64, 3>>>(m: S, o: AmpmOptions, f: &Mat<f64, 3>, z: &Mat<f64, 3>) {
         let e = FixedCorotated::with_method(2.0, m);
-        let a = augmented::ahat(&e, f).unwrap();
-        let c = augmented::chat_z(&e, f, z).unwrap();
-        let p = augmented::psi_hat(&e, f).unwrap();
+        let (a, c, p) = if o.method == AMPM_METHOD_DEFAULT {
+            use ampm_core::kernel::batch::{ahat_chat_z, Outputs};
+            let (mut a, mut c, mut p) = ([0.0; 9], [0.0; 9], [0.0; 1]);
+            let out = Outputs { ahat: Some(&mut a), chat_z: Some(&mut c), energy: Some(&mut p), psd: false };
+            let st = ahat_chat_z::<f64, 3>(ampm_core::lane::Isa::SCALAR, &[2.0], &F3, Some(&Z3), out);
+            assert_eq!(st.unwrap().error, None);
+            (Mat::from_col_major(&a).unwrap(), Mat::from_col_major(&c).unwrap(), p[0])
+        } else {
+            (
+                augmented::ahat(&e, f).unwrap(),
+                augmented::chat_z(&e, f, z).unwrap(),
+                augmented::psi_hat(&e, f).unwrap(),
+            )
+        };
         let (mut out, mut psi) = ([0.0; 9], 0.0);
         unsafe {
             assert_eq!(
@@ -296,7 +378,7 @@ fn ffi_ex_matches_compile_time_methods() {
         &z,
     );
     expect(
-        OneSidedJacobi { max_sweeps: 5 },
+        OneSidedJacobi { sweeps: 5 },
         opts(AMPM_METHOD_ONE_SIDED_JACOBI, 0, 5),
         &f,
         &z,

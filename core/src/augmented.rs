@@ -29,13 +29,14 @@ pub fn exponent_a<M: Matrix>() -> M::Scalar {
     -M::Scalar::ONE / M::Scalar::from_i32(M::DIM as i32)
 }
 
-/// `x^{−1/d}` for `x > 0`, by `sqrt` (d = 2) or `cbrt` (d = 3), not `pow`.
+/// `(x·2ᵏ)^{−1/d}` for `x > 0` ([`crate::lane::lmat::inv_root_exp`] on one scalar).
 #[inline]
-fn inv_root<M: Matrix>(x: M::Scalar) -> M::Scalar {
+fn inv_root_exp<M: Matrix>(x: M::Scalar, k: i32) -> M::Scalar {
+    let k = M::Scalar::from_i32(k);
     if M::DIM == 2 {
-        M::Scalar::ONE / x.sqrt()
+        crate::lane::lmat::inv_root_exp::<M::Scalar, 2>(x, k)
     } else {
-        M::Scalar::ONE / x.cbrt()
+        crate::lane::lmat::inv_root_exp::<M::Scalar, 3>(x, k)
     }
 }
 
@@ -65,13 +66,38 @@ impl<M: Matrix> Kinematics<M> {
         }
         let k = scale_exponent(f);
         let g = scale_pow2(f, -k);
-        let det_g = g.det();
-        // Also catches F = 0 (det 0) and det G that is NaN-free but not positive.
-        if det_g <= M::Scalar::ZERO {
+        // The determinant on power-of-two-equilibrated columns, G = Ĝ·diag(2^{e_j}) (exact):
+        // det G = det Ĝ·2^{Σe}, G⁻ᵀ = cof(Ĝ)/det Ĝ · diag(2^{−e_j}). Columns of very different
+        // sizes (1 and 1e-20 in f32) put det G below the normal range although F is well
+        // conditioned after column scaling; this way nothing under- or overflows there.
+        let mut gh = g;
+        let mut ce = [0i32; 3];
+        for j in 0..M::DIM {
+            let mut m = M::Scalar::ZERO;
+            for i in 0..M::DIM {
+                m = m.max(g[(i, j)].abs());
+            }
+            ce[j] = m.exponent();
+            for i in 0..M::DIM {
+                gh[(i, j)] = g[(i, j)].scalbn(-ce[j]);
+            }
+        }
+        let sum_e: i32 = ce.iter().sum();
+        let det_h = gh.det();
+        // Also catches F = 0 (det 0) and det G that is NaN-free but not positive. Below the
+        // smallest normal number, det Ĝ says F is singular to working precision (Hadamard
+        // ratio ∏‖g_j‖/|det G| beyond 1/MIN_POSITIVE ≫ 1/ε).
+        if !(det_h >= M::Scalar::MIN_POSITIVE) {
             return Err(Error::NonPositiveJ);
         }
-        let h_g = g.cofactor() * (M::Scalar::ONE / det_g);
-        let ja_g = inv_root::<M>(det_g);
+        let det_g = det_h.scalbn(sum_e);
+        let mut h_g = gh.cofactor() * (M::Scalar::ONE / det_h);
+        for j in 0..M::DIM {
+            for i in 0..M::DIM {
+                h_g[(i, j)] = h_g[(i, j)].scalbn(-ce[j]);
+            }
+        }
+        let ja_g = inv_root_exp::<M>(det_h, sum_e);
         let f_hat = g * ja_g;
         if !(h_g.is_finite() && ja_g.is_finite() && f_hat.is_finite()) {
             // det G so small (below ~ε^d) that G⁻ᵀ or det(G)ᵃ overflow: singular to working

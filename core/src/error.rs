@@ -17,6 +17,9 @@ pub enum Error {
     InvalidArgument,
     /// An iterative method reached its iteration cap without meeting its tolerance.
     NotConverged,
+    /// A prepared-Hessian slot that no successful prepare wrote (zero-filled, or marked by a
+    /// failed prepare): applying it would use stale or meaningless data.
+    NotPrepared,
 }
 
 /// Result type of the kernels.
@@ -30,6 +33,9 @@ impl core::fmt::Display for Error {
             Error::Overflow => "the result is not representable (overflow)",
             Error::InvalidArgument => "a parameter is outside its domain",
             Error::NotConverged => "iteration cap reached before convergence",
+            Error::NotPrepared => {
+                "the prepared-Hessian slot was not written by a successful prepare"
+            }
         })
     }
 }

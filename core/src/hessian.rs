@@ -75,8 +75,9 @@
 use crate::augmented::Augmented;
 use crate::energy::FixedCorotated;
 use crate::error::{Error, Result};
+use crate::kernel;
 use crate::mat::{Mat, Matrix};
-use crate::polar::{scale_pow2, SvdMethod};
+use crate::polar::{scale_pow2, Svd, SvdMethod};
 use crate::scalar::Real;
 use core::ops::{Index, IndexMut};
 
@@ -96,6 +97,12 @@ pub trait HessianDim: Matrix {
     /// The zero `d²×d²` matrix.
     #[must_use]
     fn wide_zero() -> Self::Wide;
+
+    /// The scaling block `K`, and `λ_sym`, `λ_skew` of each pair `(i, j)` at entry `(i, j)`,
+    /// of fixed corotated `Ĉ(G)` from the SVD of `F̂` (singular values `x > 0`) and
+    /// `s = det(G)^{−1/d}`: [`crate::kernel::coefficients`] on one scalar lane.
+    #[must_use]
+    fn coefficients(mu: Self::Scalar, svd: &Svd<Self>, s: Self::Scalar) -> (Self, Self, Self);
 }
 
 impl<T: Real> HessianDim for Mat<T, 2> {
@@ -103,6 +110,10 @@ impl<T: Real> HessianDim for Mat<T, 2> {
     #[inline]
     fn wide_zero() -> Mat<T, 4> {
         Mat::ZERO
+    }
+    #[inline]
+    fn coefficients(mu: T, svd: &Svd<Self>, s: T) -> (Self, Self, Self) {
+        coefficients_of::<T, 2>(mu, svd, s)
     }
 }
 
@@ -112,6 +123,30 @@ impl<T: Real> HessianDim for Mat<T, 3> {
     fn wide_zero() -> Mat<T, 9> {
         Mat::ZERO
     }
+    #[inline]
+    fn coefficients(mu: T, svd: &Svd<Self>, s: T) -> (Self, Self, Self) {
+        coefficients_of::<T, 3>(mu, svd, s)
+    }
+}
+
+/// [`HessianDim::coefficients`] for `Mat<T, D>`.
+#[inline]
+fn coefficients_of<T: Real, const D: usize>(
+    mu: T,
+    svd: &Svd<Mat<T, D>>,
+    s: T,
+) -> (Mat<T, D>, Mat<T, D>, Mat<T, D>)
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let co = kernel::coefficients::<T, D>(mu, &svd.u.cols, &svd.v.cols, &svd.sigma, s, T::ZERO);
+    let mut sym = Mat::<T, D>::ZERO;
+    let mut skew = Mat::<T, D>::ZERO;
+    for (p, &(i, j)) in kernel::PAIRS.iter().take(kernel::pairs(D)).enumerate() {
+        sym.cols[j][i] = co.sym[p];
+        skew.cols[j][i] = co.skew[p];
+    }
+    (Mat::from_cols(co.block), sym, skew)
 }
 
 /// Sweep cap of [`symmetric_eigen`], a safety bound: cyclic Jacobi converges quadratically
@@ -234,50 +269,13 @@ impl<M: HessianDim> HessianEigensystem<M> {
         let Some((svd, _)) = aug.base_state().svd else {
             return Ok(zero); // μ = 0
         };
-        let one = M::Scalar::ONE;
-        let d = M::Scalar::from_i32(M::DIM as i32);
-        let x = svd.sigma;
         for i in 0..M::DIM {
-            // det F̂ = 1 > 0 makes every σ̂ > 0; a non-positive one means F is singular to
-            // working precision.
-            if x[i] <= M::Scalar::ZERO {
+            if svd.sigma[i] <= M::Scalar::ZERO {
                 return Err(Error::NonPositiveJ);
             }
         }
-        // c = 2μs², s = det(G)^{−1/d}.
-        let c = (energy.mu + energy.mu) * kin.ja_g * kin.ja_g;
-        let mut q = M::Scalar::ZERO;
-        let mut w_hat = M::Vector::default();
-        let mut w_sum = M::Scalar::ZERO;
-        for i in 0..M::DIM {
-            q += x[i] * (x[i] - one);
-            w_hat[i] = x[i] * (x[i] + x[i] - one);
-            w_sum += w_hat[i];
-        }
-        let q_d = q / d;
-        let w_d2 = w_sum / (d * d);
-        let mut block = M::zero();
-        let mut sym = M::zero();
-        let mut skew = M::zero();
-        for j in 0..M::DIM {
-            for l in 0..M::DIM {
-                // Kⱼₗ = (2μs²/(xⱼxₗ)) [δⱼₗ (xⱼ² + q/d) − (ŵⱼ + ŵₗ)/d + Ŵ/d²].
-                let mut t = w_d2 - (w_hat[j] + w_hat[l]) / d;
-                if j == l {
-                    t += x[j] * x[j] + q_d;
-                }
-                block[(j, l)] = c * t / (x[j] * x[l]);
-            }
-        }
-        for j in 1..M::DIM {
-            for i in 0..j {
-                let qx = q_d / (x[i] * x[j]);
-                // λ_sym = (ψᵢ − ψⱼ)/(σᵢ − σⱼ) = 2μs²(1 + q/(d xᵢxⱼ)), exact at σᵢ = σⱼ.
-                sym[(i, j)] = c * (one + qx);
-                // λ_skew = (ψᵢ + ψⱼ)/(σᵢ + σⱼ) = 2μs²((xᵢ−1 + xⱼ−1)/(xᵢ+xⱼ) − q/(d xᵢxⱼ)).
-                skew[(i, j)] = c * (((x[i] - one) + (x[j] - one)) / (x[i] + x[j]) - qx);
-            }
-        }
+        // The formulas: `crate::kernel::coefficients` (one source with the batch kernels).
+        let (block, sym, skew) = M::coefficients(energy.mu, &svd, kin.ja_g);
         if !(block.is_finite() && sym.is_finite() && skew.is_finite()) {
             return Err(Error::Overflow);
         }

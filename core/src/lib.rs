@@ -24,11 +24,15 @@
 #![no_std]
 #![deny(missing_docs)]
 
+#[cfg(feature = "std")]
+extern crate std;
+
 pub mod augmented;
-pub mod batch;
 pub mod energy;
 pub mod error;
 pub mod hessian;
+pub mod kernel;
+pub mod lane;
 pub mod mat;
 pub mod particle;
 pub mod polar;

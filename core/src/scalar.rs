@@ -42,6 +42,8 @@ pub trait Real:
     const MAX: Self;
     /// Smallest positive normal value.
     const MIN_POSITIVE: Self;
+    /// `frexp` exponent of [`Real::MAX`] (128 or 1024): the exponent bias is `MAX_EXP − 1`.
+    const MAX_EXP: i32;
     /// Number of mantissa bits including the implicit one (24 or 53).
     const MANTISSA_DIGITS: u32;
     /// Short name used in reports and symbol names ("f32" or "f64").
@@ -86,6 +88,18 @@ pub trait Real:
     /// Binary exponent `e` with `self = m · 2^e`, `0.5 ≤ |m| < 1` (0 for zero or non-finite).
     #[must_use]
     fn exponent(self) -> i32;
+    /// Largest integer not above `self`.
+    #[must_use]
+    fn floor(self) -> Self;
+    /// `2ᵉ` for `e` in the normal range `[1 − bias, bias]` (exact).
+    #[must_use]
+    fn pow2i(e: i32) -> Self;
+    /// A first guess of `1/√self` for a positive normal `self`, relative error below 3.5e-2,
+    /// from the exponent bits alone (Lomont's constants for f32/f64): the seed of
+    /// [`crate::lane::lmat::rsqrt`]'s Newton steps. Integer operations only, so every path
+    /// (scalar, AVX2, AVX-512) gives the same bits.
+    #[must_use]
+    fn rsqrt_guess(self) -> Self;
     /// Magnitude of `self` with the sign of `sign`.
     #[must_use]
     fn copysign(self, sign: Self) -> Self;
@@ -109,7 +123,7 @@ pub trait Real:
 macro_rules! impl_real {
     ($t:ident, $m:literal, $sqrt:path, $cbrt:path, $fabs:path, $pow:path, $exp:path, $ln:path,
      $hypot:path, $fma:path, $scalbn:path, $frexp:path, $copysign:path, $fmax:path, $fmin:path,
-     $sincos:path, $atan2:path) => {
+     $sincos:path, $atan2:path, $floor:path, $magic:literal) => {
         impl Real for $t {
             const ZERO: Self = 0.0;
             const ONE: Self = 1.0;
@@ -119,6 +133,7 @@ macro_rules! impl_real {
             const MAX: Self = $t::MAX;
             const MIN_POSITIVE: Self = $t::MIN_POSITIVE;
             const MANTISSA_DIGITS: u32 = $m;
+            const MAX_EXP: i32 = $t::MAX_EXP;
             const NAME: &'static str = stringify!($t);
 
             #[inline]
@@ -171,11 +186,42 @@ macro_rules! impl_real {
             }
             #[inline]
             fn exponent(self) -> i32 {
+                // frexp's exponent from the bits: biased field − (bias − 1); a subnormal is
+                // scaled by 2^digits first (exact).
                 if self == 0.0 || !self.is_finite() {
-                    0
-                } else {
-                    $frexp(self).1
+                    return 0;
                 }
+                let a = self.abs();
+                let (y, adj) = if a < $t::MIN_POSITIVE {
+                    (a * $t::pow2i($m), $m)
+                } else {
+                    (a, 0)
+                };
+                let field = (y.to_bits() >> ($m - 1)) as i32;
+                field - ($t::MAX_EXP - 2) - adj
+            }
+            #[inline]
+            fn floor(self) -> Self {
+                // Values of magnitude ≥ 2^(digits−1) (and NaN, inf) are integers already; below
+                // that the truncating conversion is exact, then corrected toward −∞.
+                if self.abs() < (1u64 << ($m - 1)) as $t {
+                    let t = (self as i64) as $t;
+                    if t > self {
+                        t - 1.0
+                    } else {
+                        t
+                    }
+                } else {
+                    $floor(self)
+                }
+            }
+            #[inline]
+            fn pow2i(e: i32) -> Self {
+                $t::from_bits((((e + $t::MAX_EXP - 1) as u64) << ($m - 1)) as _)
+            }
+            #[inline]
+            fn rsqrt_guess(self) -> Self {
+                $t::from_bits($magic - (self.to_bits() >> 1))
             }
             #[inline]
             fn copysign(self, sign: Self) -> Self {
@@ -222,7 +268,9 @@ impl_real!(
     libm::fmaxf,
     libm::fminf,
     libm::sincosf,
-    libm::atan2f
+    libm::atan2f,
+    libm::floorf,
+    0x5f37_5a86_u32
 );
 impl_real!(
     f64,
@@ -241,5 +289,7 @@ impl_real!(
     libm::fmax,
     libm::fmin,
     libm::sincos,
-    libm::atan2
+    libm::atan2,
+    libm::floor,
+    0x5fe6_eb50_c7b5_37a9_u64
 );

@@ -9,10 +9,11 @@
 
 use crate::status::AmpmStatus;
 use ampm_core::Mat;
+use core::ptr;
 
 /// Generic bodies of the entry points of this module.
 mod imp {
-    use crate::abi::{batch_mu_f_z, binary, guard, read_mat};
+    use crate::abi::{guard, read_mat};
     use crate::status::AmpmStatus;
     use ampm_core::energy::FixedCorotated;
     use ampm_core::hessian::{self, HessianDim};
@@ -44,36 +45,6 @@ mod imp {
                 }
                 Err(e) => e.into(),
             }
-        })
-    }
-
-    pub(super) unsafe fn chat_z_psd<M: HessianDim>(
-        mu: M::Scalar,
-        f: *const M::Scalar,
-        z: *const M::Scalar,
-        out: *mut M::Scalar,
-    ) -> AmpmStatus
-    where
-        DefaultSvd: SvdMethod<M>,
-    {
-        binary::<M>(f, z, out, |f, z| {
-            hessian::chat_psd_z(&FixedCorotated::new(mu), f, z)
-        })
-    }
-
-    pub(super) unsafe fn chat_z_psd_batch<M: HessianDim>(
-        n: usize,
-        mu: *const M::Scalar,
-        f: *const M::Scalar,
-        z: *const M::Scalar,
-        out: *mut M::Scalar,
-        first_failed: *mut usize,
-    ) -> AmpmStatus
-    where
-        DefaultSvd: SvdMethod<M>,
-    {
-        batch_mu_f_z::<M>(n, mu, f, z, out, first_failed, |mu, f, z| {
-            hessian::chat_psd_z(&FixedCorotated::new(mu), f, z)
         })
     }
 
@@ -113,7 +84,7 @@ pub unsafe extern "C" fn ampm_chat_z_psd_2d_f32(
     z: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    imp::chat_z_psd::<Mat<f32, 2>>(mu, f, z, out)
+    crate::fast::single::<f32, 2>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), true)
 }
 
 /// Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
@@ -131,7 +102,18 @@ pub unsafe extern "C" fn ampm_chat_z_psd_batch_2d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    imp::chat_z_psd_batch::<Mat<f32, 2>>(n, mu, f, z, out, first_failed)
+    crate::fast::kernels::<f32, 2>(
+        crate::fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        true,
+        first_failed,
+    )
 }
 
 /// Computes the explicit 4×4 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/2), symmetric and in general indefinite.
@@ -177,7 +159,7 @@ pub unsafe extern "C" fn ampm_chat_z_psd_2d_f64(
     z: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    imp::chat_z_psd::<Mat<f64, 2>>(mu, f, z, out)
+    crate::fast::single::<f64, 2>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), true)
 }
 
 /// Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
@@ -195,7 +177,18 @@ pub unsafe extern "C" fn ampm_chat_z_psd_batch_2d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    imp::chat_z_psd_batch::<Mat<f64, 2>>(n, mu, f, z, out, first_failed)
+    crate::fast::kernels::<f64, 2>(
+        crate::fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        true,
+        first_failed,
+    )
 }
 
 /// Computes the explicit 4×4 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/2), symmetric and in general indefinite.
@@ -241,7 +234,7 @@ pub unsafe extern "C" fn ampm_chat_z_psd_3d_f32(
     z: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    imp::chat_z_psd::<Mat<f32, 3>>(mu, f, z, out)
+    crate::fast::single::<f32, 3>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), true)
 }
 
 /// Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
@@ -259,7 +252,18 @@ pub unsafe extern "C" fn ampm_chat_z_psd_batch_3d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    imp::chat_z_psd_batch::<Mat<f32, 3>>(n, mu, f, z, out, first_failed)
+    crate::fast::kernels::<f32, 3>(
+        crate::fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        true,
+        first_failed,
+    )
 }
 
 /// Computes the explicit 9×9 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/3), symmetric and in general indefinite.
@@ -305,7 +309,7 @@ pub unsafe extern "C" fn ampm_chat_z_psd_3d_f64(
     z: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    imp::chat_z_psd::<Mat<f64, 3>>(mu, f, z, out)
+    crate::fast::single::<f64, 3>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), true)
 }
 
 /// Computes Ĉ⁺:Z for n particles: `out[i]` = Ĉ⁺(mu[i], F[i]):Z[i].
@@ -323,7 +327,18 @@ pub unsafe extern "C" fn ampm_chat_z_psd_batch_3d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    imp::chat_z_psd_batch::<Mat<f64, 3>>(n, mu, f, z, out, first_failed)
+    crate::fast::kernels::<f64, 3>(
+        crate::fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        true,
+        first_failed,
+    )
 }
 
 /// Computes the explicit 9×9 Hessian Ĉ of Ψ̂ (fixed corotated, a = −1/3), symmetric and in general indefinite.

@@ -5,9 +5,11 @@
 //! without expanding macros; each carries the doc comment that reaches `ampm.h`.
 #![allow(clippy::missing_safety_doc)]
 
+use crate::fast;
 use crate::kernels_impl as k;
 use crate::status::AmpmStatus;
 use ampm_core::Mat;
+use core::ptr;
 
 /// Computes 𝓑(F):Z = Jᵃ(Z + a(H:Z)F), a = −1/2, H = F⁻ᵀ, the derivative of JᵃF in direction Z.
 ///
@@ -141,7 +143,15 @@ pub unsafe extern "C" fn ampm_energy_hat_2d_f32(
     f: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    k::energy_hat::<Mat<f32, 2>>(mu, f, out)
+    fast::single::<f32, 2>(
+        mu,
+        f,
+        ptr::null(),
+        ptr::null_mut(),
+        ptr::null_mut(),
+        out,
+        false,
+    )
 }
 
 /// Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(−1/2) F: the fixed corotated energy density of the volume-preserving part.
@@ -156,7 +166,15 @@ pub unsafe extern "C" fn ampm_energy_hat_2d_f64(
     f: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    k::energy_hat::<Mat<f64, 2>>(mu, f, out)
+    fast::single::<f64, 2>(
+        mu,
+        f,
+        ptr::null(),
+        ptr::null_mut(),
+        ptr::null_mut(),
+        out,
+        false,
+    )
 }
 
 /// Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(−1/3) F: the fixed corotated energy density of the volume-preserving part.
@@ -171,7 +189,15 @@ pub unsafe extern "C" fn ampm_energy_hat_3d_f32(
     f: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    k::energy_hat::<Mat<f32, 3>>(mu, f, out)
+    fast::single::<f32, 3>(
+        mu,
+        f,
+        ptr::null(),
+        ptr::null_mut(),
+        ptr::null_mut(),
+        out,
+        false,
+    )
 }
 
 /// Computes Ψ̂(F) = μ‖F̂ − R̂‖², F̂ = J^(−1/3) F: the fixed corotated energy density of the volume-preserving part.
@@ -186,7 +212,15 @@ pub unsafe extern "C" fn ampm_energy_hat_3d_f64(
     f: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    k::energy_hat::<Mat<f64, 3>>(mu, f, out)
+    fast::single::<f64, 3>(
+        mu,
+        f,
+        ptr::null(),
+        ptr::null_mut(),
+        ptr::null_mut(),
+        out,
+        false,
+    )
 }
 
 /// Computes Â = ∂Ψ̂/∂F, the first Piola–Kirchhoff stress of the volume-preserving fixed corotated energy.
@@ -197,7 +231,15 @@ pub unsafe extern "C" fn ampm_energy_hat_3d_f64(
 /// Non-null pointers must be valid for the sizes above.
 #[no_mangle]
 pub unsafe extern "C" fn ampm_ahat_2d_f32(mu: f32, f: *const f32, out: *mut f32) -> AmpmStatus {
-    k::ahat::<Mat<f32, 2>>(mu, f, out)
+    fast::single::<f32, 2>(
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+    )
 }
 
 /// Computes Â = ∂Ψ̂/∂F, the first Piola–Kirchhoff stress of the volume-preserving fixed corotated energy.
@@ -208,7 +250,15 @@ pub unsafe extern "C" fn ampm_ahat_2d_f32(mu: f32, f: *const f32, out: *mut f32)
 /// Non-null pointers must be valid for the sizes above.
 #[no_mangle]
 pub unsafe extern "C" fn ampm_ahat_2d_f64(mu: f64, f: *const f64, out: *mut f64) -> AmpmStatus {
-    k::ahat::<Mat<f64, 2>>(mu, f, out)
+    fast::single::<f64, 2>(
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+    )
 }
 
 /// Computes Â = ∂Ψ̂/∂F, the first Piola–Kirchhoff stress of the volume-preserving fixed corotated energy.
@@ -219,7 +269,15 @@ pub unsafe extern "C" fn ampm_ahat_2d_f64(mu: f64, f: *const f64, out: *mut f64)
 /// Non-null pointers must be valid for the sizes above.
 #[no_mangle]
 pub unsafe extern "C" fn ampm_ahat_3d_f32(mu: f32, f: *const f32, out: *mut f32) -> AmpmStatus {
-    k::ahat::<Mat<f32, 3>>(mu, f, out)
+    fast::single::<f32, 3>(
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+    )
 }
 
 /// Computes Â = ∂Ψ̂/∂F, the first Piola–Kirchhoff stress of the volume-preserving fixed corotated energy.
@@ -230,7 +288,15 @@ pub unsafe extern "C" fn ampm_ahat_3d_f32(mu: f32, f: *const f32, out: *mut f32)
 /// Non-null pointers must be valid for the sizes above.
 #[no_mangle]
 pub unsafe extern "C" fn ampm_ahat_3d_f64(mu: f64, f: *const f64, out: *mut f64) -> AmpmStatus {
-    k::ahat::<Mat<f64, 3>>(mu, f, out)
+    fast::single::<f64, 3>(
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+    )
 }
 
 /// Computes Ĉ:Z, the action of the Hessian ∂²Ψ̂/∂F∂F of the volume-preserving fixed corotated energy on Z.
@@ -246,7 +312,7 @@ pub unsafe extern "C" fn ampm_chat_z_2d_f32(
     z: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    k::chat_z::<Mat<f32, 2>>(mu, f, z, out)
+    fast::single::<f32, 2>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), false)
 }
 
 /// Computes Ĉ:Z, the action of the Hessian ∂²Ψ̂/∂F∂F of the volume-preserving fixed corotated energy on Z.
@@ -262,7 +328,7 @@ pub unsafe extern "C" fn ampm_chat_z_2d_f64(
     z: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    k::chat_z::<Mat<f64, 2>>(mu, f, z, out)
+    fast::single::<f64, 2>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), false)
 }
 
 /// Computes Ĉ:Z, the action of the Hessian ∂²Ψ̂/∂F∂F of the volume-preserving fixed corotated energy on Z.
@@ -278,7 +344,7 @@ pub unsafe extern "C" fn ampm_chat_z_3d_f32(
     z: *const f32,
     out: *mut f32,
 ) -> AmpmStatus {
-    k::chat_z::<Mat<f32, 3>>(mu, f, z, out)
+    fast::single::<f32, 3>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), false)
 }
 
 /// Computes Ĉ:Z, the action of the Hessian ∂²Ψ̂/∂F∂F of the volume-preserving fixed corotated energy on Z.
@@ -294,7 +360,7 @@ pub unsafe extern "C" fn ampm_chat_z_3d_f64(
     z: *const f64,
     out: *mut f64,
 ) -> AmpmStatus {
-    k::chat_z::<Mat<f64, 3>>(mu, f, z, out)
+    fast::single::<f64, 3>(mu, f, z, ptr::null_mut(), out, ptr::null_mut(), false)
 }
 
 /// Computes Â for n particles: `out[i]` = Â(mu[i], F[i]).
@@ -311,7 +377,18 @@ pub unsafe extern "C" fn ampm_ahat_batch_2d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch::<Mat<f32, 2>>(n, mu, f, out, first_failed)
+    fast::kernels::<f32, 2>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Â for n particles: `out[i]` = Â(mu[i], F[i]).
@@ -328,7 +405,18 @@ pub unsafe extern "C" fn ampm_ahat_batch_2d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch::<Mat<f64, 2>>(n, mu, f, out, first_failed)
+    fast::kernels::<f64, 2>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Â for n particles: `out[i]` = Â(mu[i], F[i]).
@@ -345,7 +433,18 @@ pub unsafe extern "C" fn ampm_ahat_batch_3d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch_per_particle::<Mat<f32, 3>>(n, mu, f, out, first_failed)
+    fast::kernels::<f32, 3>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Â for n particles: `out[i]` = Â(mu[i], F[i]).
@@ -362,7 +461,18 @@ pub unsafe extern "C" fn ampm_ahat_batch_3d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::ahat_batch_per_particle::<Mat<f64, 3>>(n, mu, f, out, first_failed)
+    fast::kernels::<f64, 3>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        ptr::null(),
+        out,
+        ptr::null_mut(),
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -380,7 +490,18 @@ pub unsafe extern "C" fn ampm_chat_z_batch_2d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch::<Mat<f32, 2>>(n, mu, f, z, out, first_failed)
+    fast::kernels::<f32, 2>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -398,7 +519,18 @@ pub unsafe extern "C" fn ampm_chat_z_batch_2d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch::<Mat<f64, 2>>(n, mu, f, z, out, first_failed)
+    fast::kernels::<f64, 2>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -416,7 +548,18 @@ pub unsafe extern "C" fn ampm_chat_z_batch_3d_f32(
     out: *mut f32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch_per_particle::<Mat<f32, 3>>(n, mu, f, z, out, first_failed)
+    fast::kernels::<f32, 3>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }
 
 /// Computes Ĉ:Z for n particles: `out[i]` = Ĉ(mu[i], F[i]):Z[i].
@@ -434,5 +577,16 @@ pub unsafe extern "C" fn ampm_chat_z_batch_3d_f64(
     out: *mut f64,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    k::chat_z_batch_per_particle::<Mat<f64, 3>>(n, mu, f, z, out, first_failed)
+    fast::kernels::<f64, 3>(
+        fast::isa(),
+        n,
+        mu,
+        f,
+        z,
+        ptr::null_mut(),
+        out,
+        ptr::null_mut(),
+        false,
+        first_failed,
+    )
 }

@@ -7,12 +7,15 @@
 //! The header `include/ampm.h` is generated from this crate by cbindgen (see `tests/header.rs`).
 
 mod abi;
+mod fast;
 pub mod hessian;
 pub mod kernels;
 mod kernels_impl;
 pub mod methods;
 pub mod particle;
+pub mod prepared;
 pub mod status;
 
 pub use kernels::*;
+pub use prepared::*;
 pub use status::AmpmStatus;

@@ -26,7 +26,8 @@ use core::ptr;
 
 /// `AmpmOptions::method`: the default of the dimension (2D closed form, 3D one-sided Jacobi).
 pub const AMPM_METHOD_DEFAULT: u32 = 0;
-/// `AmpmOptions::method`: one-sided (Hestenes) Jacobi on F, 3D; `max_iterations` caps sweeps.
+/// `AmpmOptions::method`: one-sided (Hestenes) Jacobi on F, 3D; `max_iterations` sets the
+/// number of sweeps.
 pub const AMPM_METHOD_ONE_SIDED_JACOBI: u32 = 1;
 /// `AmpmOptions::method`: McAdams et al. 2011 branch-free Jacobi on FᵀF, 3D; `sweeps` sweeps.
 pub const AMPM_METHOD_MCADAMS: u32 = 2;
@@ -56,11 +57,11 @@ pub struct AmpmOptions {
     pub method: u32,
     /// Jacobi sweeps of `AMPM_METHOD_MCADAMS`: 0 (default, 4) or 2..=8.
     pub sweeps: u32,
-    /// Iteration cap of `AMPM_METHOD_ONE_SIDED_JACOBI` (sweeps, default 12), `AMPM_METHOD_QR`
-    /// (QR sweeps, default 32), `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per
-    /// eigen-solve, default 16): 0 (default) or 1..=1000. Reaching it without convergence is
-    /// `AMPM_ERR_NOT_CONVERGED` (QR, Higham–Noferini); one-sided Jacobi returns its last
-    /// iterate.
+    /// Sweeps of `AMPM_METHOD_ONE_SIDED_JACOBI` (a fixed count, no stopping test; default 4
+    /// in f32, 5 in f64), iteration cap of `AMPM_METHOD_QR` (QR sweeps, default 32) and of
+    /// `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per eigen-solve, default 16): 0 (default)
+    /// or 1..=1000. Reaching a cap without convergence is `AMPM_ERR_NOT_CONVERGED` (QR,
+    /// Higham–Noferini).
     pub max_iterations: u32,
 }
 
@@ -98,7 +99,7 @@ impl RuntimeSvd {
             (AMPM_METHOD_DEFAULT, 2 | 3) => Ok(RuntimeSvd::Default),
             (AMPM_METHOD_CLOSED_FORM_2D, 2) => Ok(RuntimeSvd::ClosedForm2),
             (AMPM_METHOD_ONE_SIDED_JACOBI, 3) => Ok(RuntimeSvd::OneSidedJacobi(OneSidedJacobi {
-                max_sweeps: iters(OneSidedJacobi::default().max_sweeps)?,
+                sweeps: iters(0)?,
             })),
             (AMPM_METHOD_MCADAMS, 3) => match opts.sweeps {
                 0 => Ok(RuntimeSvd::McAdams(McAdams::default())),
@@ -158,7 +159,73 @@ unsafe fn options<M: Matrix>(opts: *const AmpmOptions) -> Result<RuntimeSvd, Err
     RuntimeSvd::from_options(&o, M::DIM)
 }
 
-unsafe fn energy_hat_ex<M: Matrix>(
+/// The default method runs the same fast kernels as the entry points without `_ex`, so NULL
+/// options give exactly their results.
+trait Fast: Matrix {
+    /// [`crate::fast::kernels`] on the batch instruction set (`batch`) or the scalar path.
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn fast(
+        batch: bool,
+        n: usize,
+        mu: *const Self::Scalar,
+        f: *const Self::Scalar,
+        z: *const Self::Scalar,
+        ahat: *mut Self::Scalar,
+        chat_z: *mut Self::Scalar,
+        energy: *mut Self::Scalar,
+        first_failed: *mut usize,
+    ) -> AmpmStatus;
+}
+
+macro_rules! impl_fast {
+    ($t:ty, $d:literal) => {
+        impl Fast for Mat<$t, $d> {
+            unsafe fn fast(
+                batch: bool,
+                n: usize,
+                mu: *const $t,
+                f: *const $t,
+                z: *const $t,
+                ahat: *mut $t,
+                chat_z: *mut $t,
+                energy: *mut $t,
+                first_failed: *mut usize,
+            ) -> AmpmStatus {
+                let isa = if batch {
+                    crate::fast::isa()
+                } else {
+                    ampm_core::lane::Isa::SCALAR
+                };
+                crate::fast::kernels::<$t, $d>(
+                    isa,
+                    n,
+                    mu,
+                    f,
+                    z,
+                    ahat,
+                    chat_z,
+                    energy,
+                    false,
+                    first_failed,
+                )
+            }
+        }
+    };
+}
+impl_fast!(f32, 2);
+impl_fast!(f64, 2);
+impl_fast!(f32, 3);
+impl_fast!(f64, 3);
+
+/// `true` when `opts` selects the default method (NULL, or `method = AMPM_METHOD_DEFAULT`).
+///
+/// # Safety
+/// `opts` is NULL or valid for reading one `AmpmOptions`.
+unsafe fn is_default<M: Matrix>(opts: *const AmpmOptions) -> bool {
+    matches!(options::<M>(opts), Ok(RuntimeSvd::Default))
+}
+
+unsafe fn energy_hat_ex<M: Fast>(
     opts: *const AmpmOptions,
     mu: M::Scalar,
     f: *const M::Scalar,
@@ -167,6 +234,20 @@ unsafe fn energy_hat_ex<M: Matrix>(
 where
     RuntimeSvd: SvdMethod<M>,
 {
+    if is_default::<M>(opts) {
+        let mu = [mu];
+        return M::fast(
+            false,
+            1,
+            mu.as_ptr(),
+            f,
+            ptr::null(),
+            ptr::null_mut(),
+            ptr::null_mut(),
+            out,
+            ptr::null_mut(),
+        );
+    }
     guard(|| {
         if f.is_null() || out.is_null() {
             return AmpmStatus::AMPM_ERR_NULL_POINTER;
@@ -185,7 +266,7 @@ where
     })
 }
 
-unsafe fn ahat_ex<M: Matrix>(
+unsafe fn ahat_ex<M: Fast>(
     opts: *const AmpmOptions,
     mu: M::Scalar,
     f: *const M::Scalar,
@@ -194,12 +275,26 @@ unsafe fn ahat_ex<M: Matrix>(
 where
     RuntimeSvd: SvdMethod<M>,
 {
+    if is_default::<M>(opts) {
+        let mu = [mu];
+        return M::fast(
+            false,
+            1,
+            mu.as_ptr(),
+            f,
+            ptr::null(),
+            out,
+            ptr::null_mut(),
+            ptr::null_mut(),
+            ptr::null_mut(),
+        );
+    }
     unary::<M>(f, out, |f| {
         augmented::ahat(&FixedCorotated::with_method(mu, options::<M>(opts)?), f)
     })
 }
 
-unsafe fn chat_z_ex<M: Matrix>(
+unsafe fn chat_z_ex<M: Fast>(
     opts: *const AmpmOptions,
     mu: M::Scalar,
     f: *const M::Scalar,
@@ -209,12 +304,26 @@ unsafe fn chat_z_ex<M: Matrix>(
 where
     RuntimeSvd: SvdMethod<M>,
 {
+    if is_default::<M>(opts) {
+        let mu = [mu];
+        return M::fast(
+            false,
+            1,
+            mu.as_ptr(),
+            f,
+            z,
+            ptr::null_mut(),
+            out,
+            ptr::null_mut(),
+            ptr::null_mut(),
+        );
+    }
     binary::<M>(f, z, out, |f, z| {
         augmented::chat_z(&FixedCorotated::with_method(mu, options::<M>(opts)?), f, z)
     })
 }
 
-unsafe fn ahat_batch_ex<M: Matrix>(
+unsafe fn ahat_batch_ex<M: Fast>(
     opts: *const AmpmOptions,
     n: usize,
     mu: *const M::Scalar,
@@ -225,6 +334,19 @@ unsafe fn ahat_batch_ex<M: Matrix>(
 where
     RuntimeSvd: SvdMethod<M>,
 {
+    if is_default::<M>(opts) {
+        return M::fast(
+            true,
+            n,
+            mu,
+            f,
+            ptr::null(),
+            out,
+            ptr::null_mut(),
+            ptr::null_mut(),
+            first_failed,
+        );
+    }
     guard(|| {
         let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), out.is_null()]);
         if st != AmpmStatus::AMPM_OK {
@@ -241,7 +363,7 @@ where
     })
 }
 
-unsafe fn chat_z_batch_ex<M: Matrix>(
+unsafe fn chat_z_batch_ex<M: Fast>(
     opts: *const AmpmOptions,
     n: usize,
     mu: *const M::Scalar,
@@ -253,6 +375,19 @@ unsafe fn chat_z_batch_ex<M: Matrix>(
 where
     RuntimeSvd: SvdMethod<M>,
 {
+    if is_default::<M>(opts) {
+        return M::fast(
+            true,
+            n,
+            mu,
+            f,
+            z,
+            ptr::null_mut(),
+            out,
+            ptr::null_mut(),
+            first_failed,
+        );
+    }
     guard(|| {
         let st = check_batch::<M>(n, &[mu.is_null(), f.is_null(), z.is_null(), out.is_null()]);
         if st != AmpmStatus::AMPM_OK {

@@ -26,6 +26,9 @@ pub enum AmpmStatus {
     AMPM_ERR_NOT_CONVERGED = 6,
     /// An internal error was caught at the ABI boundary (a bug: please report it).
     AMPM_ERR_INTERNAL = 7,
+    /// A prepared-Hessian slot that no successful `ampm_hessian_prepare_batch_*` wrote
+    /// (zero-filled memory, or the slot of a particle whose prepare failed).
+    AMPM_ERR_NOT_PREPARED = 8,
 }
 
 impl From<Error> for AmpmStatus {
@@ -37,6 +40,7 @@ impl From<Error> for AmpmStatus {
             Error::Overflow => AmpmStatus::AMPM_ERR_OVERFLOW,
             Error::InvalidArgument => AmpmStatus::AMPM_ERR_INVALID_ARGUMENT,
             Error::NotConverged => AmpmStatus::AMPM_ERR_NOT_CONVERGED,
+            Error::NotPrepared => AmpmStatus::AMPM_ERR_NOT_PREPARED,
         }
     }
 }

@@ -3,7 +3,7 @@
 //! curves for the stability chart, and the p99 errors that pair with [`crate::methods`]'
 //! timings in the speed–accuracy chart.
 
-use crate::charts::{Curve, Panel, SpeedPoint};
+use crate::charts::{Curve, KernelPoint, Panel, SpeedPoint};
 use crate::methods::MethodTiming;
 use ampm_tools::families::{Family, Size};
 use ampm_tools::stability::{self, HaarP99, MethodSpec, Quantity, Report};
@@ -193,4 +193,58 @@ pub fn speed_points(timings: &[MethodTiming], acc: &Accuracy) -> Vec<SpeedPoint>
             })
         })
         .collect()
+}
+
+/// The `SvdMethod::NAME` of the default decomposition of dimension `dim` (the one the fast
+/// path runs on lanes): the closed form in 2D, one-sided Jacobi in 3D.
+fn default_key(dim: usize) -> &'static str {
+    if dim == 2 {
+        "closed-form-2d"
+    } else {
+        "one-sided-jacobi"
+    }
+}
+
+/// The generic single-particle path with the default decomposition, per dim × precision: its
+/// time of `Â + Ĉ:Z` ([`crate::methods`]) and its p99 errors of `Â`, `Ĉ:Z` on the same family
+/// (the stability measurement), the comparison points of the chart's lower panel.
+#[must_use]
+#[inline]
+pub fn generic_kernel_points(timings: &[MethodTiming], acc: &Accuracy) -> Vec<KernelPoint> {
+    timings
+        .iter()
+        .filter(|t| t.key == default_key(t.dim) && t.sweeps.is_none())
+        .filter_map(|t| {
+            let p = p99_of(t, acc)?;
+            Some(KernelPoint {
+                series: t.method.clone(),
+                legend: format!("{} (generic single-particle path)", t.method),
+                label: format!("generic {}D {}", t.dim, t.precision),
+                is_f32: t.precision == "f32",
+                ns: t.ns_kernels,
+                p99_ahat: p.raw[qi(Quantity::Ahat)]?,
+                p99_chat_z: p.raw[qi(Quantity::ChatZ)]?,
+            })
+        })
+        .collect()
+}
+
+/// The generic path's row of the fast-path table: `(ns Â + Ĉ:Z, p99 Â, p99 Ĉ:Z)`.
+#[must_use]
+#[inline]
+pub fn generic_row(
+    timings: &[MethodTiming],
+    acc: &Accuracy,
+    dim: usize,
+    precision: &str,
+) -> Option<(f64, Option<f64>, Option<f64>)> {
+    let t = timings.iter().find(|t| {
+        t.key == default_key(dim) && t.sweeps.is_none() && t.dim == dim && t.precision == precision
+    })?;
+    let p = p99_of(t, acc);
+    Some((
+        t.ns_kernels,
+        p.and_then(|p| p.raw[qi(Quantity::Ahat)]),
+        p.and_then(|p| p.raw[qi(Quantity::ChatZ)]),
+    ))
 }

@@ -80,6 +80,48 @@ pub struct SpeedPoint {
     pub p99: f64,
 }
 
+/// One point of the speed–accuracy chart's lower panel (kernel outputs): a configuration's
+/// time of `Â + Ĉ:Z` and its p99 errors of `Â` (filled marker) and `Ĉ:Z` (hollow marker).
+#[derive(Clone, Debug)]
+pub struct KernelPoint {
+    /// Color key: a method name of the upper panel (same color there) or a new series.
+    pub series: String,
+    /// Legend text of the series.
+    pub legend: String,
+    /// Label next to the `Â` marker, e.g. "avx512 3D f32".
+    pub label: String,
+    /// Precision: f32 points are triangles, f64 points circles.
+    pub is_f32: bool,
+    /// ns per particle of `Â + Ĉ:Z`.
+    pub ns: f64,
+    /// p99 relative error of `Â` against the double-double reference.
+    pub p99_ahat: f64,
+    /// p99 relative error of `Ĉ:Z` against the double-double reference.
+    pub p99_chat_z: f64,
+}
+
+/// A time without an error on the reference's scale: a vertical dashed line.
+#[derive(Clone, Debug)]
+pub struct TimeLine {
+    /// Label at the top of the line, e.g. "Eigen 3D f32".
+    pub label: String,
+    /// ns per particle.
+    pub ns: f64,
+}
+
+/// The speed–accuracy chart's lower panel.
+#[derive(Clone, Debug, Default)]
+pub struct KernelPanel {
+    /// Caption.
+    pub title: String,
+    /// Points with errors.
+    pub points: Vec<KernelPoint>,
+    /// Vertical lines (times without a measured error).
+    pub lines: Vec<TimeLine>,
+    /// Legend text of the vertical lines.
+    pub lines_legend: String,
+}
+
 /// Errors below this are drawn at this value (a log axis has no zero).
 pub const ERROR_FLOOR: f64 = 1e-18;
 
@@ -108,16 +150,68 @@ fn err<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
-/// Draws the speed–accuracy chart on `root`.
-fn draw_speed<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>, pts: &[SpeedPoint]) -> DrawResult
+/// A label box in pixels: `(left, top, right, bottom)`.
+type LabelBox = (i32, i32, i32, i32);
+
+/// Draws each label (anchor in backend pixels, text) at the first candidate offset whose box
+/// overlaps no label in `placed` (which it then joins).
+fn place_labels<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    labels: &[((i32, i32), String)],
+    placed: &mut Vec<LabelBox>,
+) -> DrawResult
 where
     DB::ErrorType: 'static,
 {
-    root.fill(&WHITE).map_err(err)?;
-    let xr = log_range(
-        pts.iter().flat_map(|p| [p.ns_kernels, p.ns_svd]),
-        ERROR_FLOOR,
-    );
+    let font: TextStyle = (FONT, 11).into();
+    let (bx, by) = area.get_base_pixel();
+    for ((px, py), text) in labels {
+        let (px, py) = (px - bx, py - by);
+        let (w, h) = area.estimate_text_size(text, &font).map_err(err)?;
+        let (w, h) = (w as i32, h as i32);
+        let candidates = [
+            (8, 2),
+            (8, -h - 2),
+            (8, h + 4),
+            (8, -2 * h - 4),
+            (8, 2 * h + 6),
+            (-w - 8, 2),
+            (-w - 8, -h - 2),
+            (-w - 8, h + 4),
+        ];
+        let free = |x: i32, y: i32| {
+            placed
+                .iter()
+                .all(|&(a, b, c, d)| x + w <= a || x >= c || y + h <= b || y >= d)
+        };
+        let (dx, dy) = candidates
+            .iter()
+            .copied()
+            .find(|&(dx, dy)| free(px + dx, py + dy))
+            .unwrap_or(candidates[0]);
+        let (x, y) = (px + dx, py + dy);
+        placed.push((x, y, x + w, y + h));
+        area.draw(&Text::new(text.clone(), (x, y), font.clone()))
+            .map_err(err)?;
+    }
+    Ok(())
+}
+
+/// The color of a series: its position in `keys` (the upper panel's methods first).
+fn series_color(keys: &[String], key: &str) -> RGBColor {
+    color(keys.iter().position(|k| k == key).unwrap_or(0))
+}
+
+/// Draws the upper panel: SVD methods, p99 error of `R` against time.
+fn draw_speed<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    pts: &[SpeedPoint],
+    xr: std::ops::Range<f64>,
+    keys: &[String],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
     let yr = log_range(pts.iter().map(|p| p.p99), ERROR_FLOOR);
     let mut chart = ChartBuilder::on(root)
         .caption(
@@ -146,8 +240,8 @@ where
             methods.push(&p.method);
         }
     }
-    for (mi, m) in methods.iter().enumerate() {
-        let c = color(mi);
+    for m in &methods {
+        let c = series_color(keys, m);
         let mine: Vec<&SpeedPoint> = pts.iter().filter(|p| p.method == *m).collect();
         // The SVD alone → the full Â + Ĉ:Z, at the same error.
         for p in &mine {
@@ -204,37 +298,17 @@ where
                 .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 7, filled));
         }
     }
-    // Labels last, each at the first candidate offset whose box overlaps no earlier label.
-    let font: TextStyle = (FONT, 11).into();
-    let mut placed: Vec<(i32, i32, i32, i32)> = Vec::new();
-    for p in pts {
-        let (px, py) = chart.backend_coord(&(p.ns_kernels, p.p99.max(ERROR_FLOOR)));
-        let (w, h) = root.estimate_text_size(&p.label, &font).map_err(err)?;
-        let (w, h) = (w as i32, h as i32);
-        let candidates = [
-            (8, 2),
-            (8, -h - 2),
-            (8, h + 4),
-            (8, -2 * h - 4),
-            (8, 2 * h + 6),
-            (-w - 8, 2),
-            (-w - 8, -h - 2),
-        ];
-        let free = |x: i32, y: i32| {
-            placed
-                .iter()
-                .all(|&(a, b, c, d)| x + w <= a || x >= c || y + h <= b || y >= d)
-        };
-        let (dx, dy) = candidates
-            .iter()
-            .copied()
-            .find(|&(dx, dy)| free(px + dx, py + dy))
-            .unwrap_or(candidates[0]);
-        let (x, y) = (px + dx, py + dy);
-        placed.push((x, y, x + w, y + h));
-        root.draw(&Text::new(p.label.clone(), (x, y), font.clone()))
-            .map_err(err)?;
-    }
+    // Labels last, so that none is hidden under a marker.
+    let labels: Vec<((i32, i32), String)> = pts
+        .iter()
+        .map(|p| {
+            (
+                chart.backend_coord(&(p.ns_kernels, p.p99.max(ERROR_FLOOR))),
+                p.label.clone(),
+            )
+        })
+        .collect();
+    place_labels(root, &labels, &mut Vec::new())?;
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::LowerRight)
@@ -243,15 +317,206 @@ where
         .label_font((FONT, 14))
         .draw()
         .map_err(err)?;
+    Ok(())
+}
+
+/// Draws the lower panel: p99 errors of `Â` (filled) and `Ĉ:Z` (hollow) against the time of
+/// `Â + Ĉ:Z`, and the vertical lines of times without an error.
+fn draw_kernels<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    panel: &KernelPanel,
+    xr: std::ops::Range<f64>,
+    keys: &[String],
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    let yr = log_range(
+        panel.points.iter().flat_map(|p| [p.p99_ahat, p.p99_chat_z]),
+        ERROR_FLOOR,
+    );
+    let mut chart = ChartBuilder::on(root)
+        .caption(&panel.title, (FONT, 20))
+        .margin(16)
+        .x_label_area_size(48)
+        .y_label_area_size(72)
+        .build_cartesian_2d(xr.log_scale(), yr.clone().log_scale())
+        .map_err(err)?;
+    chart
+        .configure_mesh()
+        .x_desc("time per particle of Â + Ĉ:Z, ns (● f64, ▲ f32)")
+        .y_desc("p99 rel. error vs double-double (filled: Â, hollow: Ĉ:Z)")
+        .x_label_formatter(&|v| format!("{v:.0}"))
+        .y_label_formatter(&sci)
+        .label_style((FONT, 14))
+        .axis_desc_style((FONT, 15))
+        .draw()
+        .map_err(err)?;
+
+    // Vertical lines first (under the markers), one legend entry for all.
+    let dark = RGBColor(60, 60, 60);
+    for (i, l) in panel.lines.iter().enumerate() {
+        let s = chart
+            .draw_series(DashedLineSeries::new(
+                vec![(l.ns, yr.start), (l.ns, yr.end)],
+                5,
+                4,
+                dark.stroke_width(2),
+            ))
+            .map_err(err)?;
+        if i == 0 {
+            s.label(panel.lines_legend.clone()).legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 16, y)], dark.stroke_width(2))
+            });
+        }
+    }
+
+    let mut series: Vec<(&str, &str)> = Vec::new();
+    for p in &panel.points {
+        if !series.iter().any(|(k, _)| *k == p.series) {
+            series.push((&p.series, &p.legend));
+        }
+    }
+    for (key, legend) in &series {
+        let c = series_color(keys, key);
+        let mine: Vec<&KernelPoint> = panel.points.iter().filter(|p| p.series == *key).collect();
+        for p in &mine {
+            let (ya, yc) = (p.p99_ahat.max(ERROR_FLOOR), p.p99_chat_z.max(ERROR_FLOOR));
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    vec![(p.ns, ya), (p.ns, yc)],
+                    c.mix(0.35).stroke_width(1),
+                )))
+                .map_err(err)?;
+            let (outer, inner) = (c.filled(), WHITE.filled());
+            if p.is_f32 {
+                chart
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((p.ns, yc))
+                            + TriangleMarker::new((0, 0), 7, outer)
+                            + TriangleMarker::new((0, 0), 3, inner),
+                    ))
+                    .map_err(err)?;
+            } else {
+                chart
+                    .draw_series(std::iter::once(
+                        EmptyElement::at((p.ns, yc))
+                            + Circle::new((0, 0), 5, outer)
+                            + Circle::new((0, 0), 3, inner),
+                    ))
+                    .map_err(err)?;
+            }
+        }
+        let filled = c.filled();
+        let at = |p: &KernelPoint| (p.ns, p.p99_ahat.max(ERROR_FLOOR));
+        let f64s = chart
+            .draw_series(
+                mine.iter()
+                    .filter(|p| !p.is_f32)
+                    .map(|p| EmptyElement::at(at(p)) + Circle::new((0, 0), 5, filled)),
+            )
+            .map_err(err)?;
+        let has_f64 = mine.iter().any(|p| !p.is_f32);
+        if has_f64 {
+            f64s.label(legend.to_string())
+                .legend(move |(x, y)| Circle::new((x + 8, y), 5, filled));
+        }
+        let f32s = chart
+            .draw_series(
+                mine.iter()
+                    .filter(|p| p.is_f32)
+                    .map(|p| EmptyElement::at(at(p)) + TriangleMarker::new((0, 0), 7, filled)),
+            )
+            .map_err(err)?;
+        if !has_f64 {
+            f32s.label(legend.to_string())
+                .legend(move |(x, y)| TriangleMarker::new((x + 8, y), 7, filled));
+        }
+    }
+    // Labels: the lines' at the top of the plot, then the points' (next to the Â marker).
+    let mut labels: Vec<((i32, i32), String)> = panel
+        .lines
+        .iter()
+        .map(|l| {
+            let (x, y) = chart.backend_coord(&(l.ns, yr.end));
+            ((x - 4, y + 4), l.label.clone())
+        })
+        .collect();
+    labels.extend(panel.points.iter().map(|p| {
+        (
+            chart.backend_coord(&(p.ns, p.p99_ahat.max(ERROR_FLOOR))),
+            p.label.clone(),
+        )
+    }));
+    place_labels(root, &labels, &mut Vec::new())?;
+    chart
+        .configure_series_labels()
+        .position(SeriesLabelPosition::LowerRight)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font((FONT, 14))
+        .draw()
+        .map_err(err)?;
+    Ok(())
+}
+
+/// Draws both panels on `root`, over one time axis.
+fn draw_speed_accuracy<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    pts: &[SpeedPoint],
+    panel: &KernelPanel,
+) -> DrawResult
+where
+    DB::ErrorType: 'static,
+{
+    root.fill(&WHITE).map_err(err)?;
+    let xr = log_range(
+        pts.iter()
+            .flat_map(|p| [p.ns_kernels, p.ns_svd])
+            .chain(panel.points.iter().map(|p| p.ns))
+            .chain(panel.lines.iter().map(|l| l.ns)),
+        ERROR_FLOOR,
+    );
+    // Colors: the upper panel's methods in order, then the lower panel's other series.
+    let mut keys: Vec<String> = Vec::new();
+    for k in pts
+        .iter()
+        .map(|p| &p.method)
+        .chain(panel.points.iter().map(|p| &p.series))
+    {
+        if !keys.contains(k) {
+            keys.push(k.clone());
+        }
+    }
+    let (upper, lower) = root.split_vertically(SPEED_UPPER_HEIGHT);
+    draw_speed(&upper, pts, xr.clone(), &keys)?;
+    draw_kernels(&lower, panel, xr, &keys)?;
     root.present().map_err(err)
 }
 
-/// Writes the speed–accuracy chart as SVG and PNG.
+/// Size of the speed–accuracy chart, and the height of its upper panel.
+const SPEED_SIZE: (u32, u32) = (1200, 1500);
+const SPEED_UPPER_HEIGHT: u32 = 780;
+
+/// Writes the speed–accuracy chart as SVG and PNG: the SVD methods (upper panel) and the
+/// kernel outputs (lower panel).
 #[inline]
-pub fn speed_accuracy(pts: &[SpeedPoint], svg: &Path, png: &Path) -> DrawResult {
-    let size = (1200, 800);
-    draw_speed(&SVGBackend::new(svg, size).into_drawing_area(), pts)?;
-    draw_speed(&BitMapBackend::new(png, size).into_drawing_area(), pts)
+pub fn speed_accuracy(
+    pts: &[SpeedPoint],
+    panel: &KernelPanel,
+    svg: &Path,
+    png: &Path,
+) -> DrawResult {
+    draw_speed_accuracy(
+        &SVGBackend::new(svg, SPEED_SIZE).into_drawing_area(),
+        pts,
+        panel,
+    )?;
+    draw_speed_accuracy(
+        &BitMapBackend::new(png, SPEED_SIZE).into_drawing_area(),
+        pts,
+        panel,
+    )
 }
 
 /// One curve of the stability chart: name ("method f32"), whether f32 (dashed), points.

@@ -89,7 +89,7 @@ pub const CONFIGS: usize = 4 + MCADAMS_SWEEPS.len();
 
 /// The timing batch of dimension `D` in precision `T`: the family's matrices (exactly
 /// representable in `T`) with seeded unit directions `Z`.
-fn batch<T: Real, const D: usize>(size: Size) -> Vec<(Mat<T, D>, Mat<T, D>)>
+pub(crate) fn batch<T: Real, const D: usize>(size: Size) -> Vec<(Mat<T, D>, Mat<T, D>)>
 where
     Mat<f64, D>: FamilyDim + HaarRotation,
 {

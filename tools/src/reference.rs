@@ -172,6 +172,7 @@ impl Real for Dd {
     /// `2⁻⁹⁶⁹`: below it the trailing part would be subnormal (fewer than 106 bits).
     const MIN_POSITIVE: Self = Dd::exact(2.004_168_360_008_973e-292);
     const MANTISSA_DIGITS: u32 = 106;
+    const MAX_EXP: i32 = f64::MAX_EXP;
     const NAME: &'static str = "dd";
 
     #[inline]
@@ -192,6 +193,29 @@ impl Real for Dd {
             return Dd::exact(self.hi.sqrt());
         }
         Dd::from_tf(self.tf().sqrt())
+    }
+    #[inline]
+    fn floor(self) -> Self {
+        let h = self.hi.floor();
+        if h == self.hi {
+            // An integer leading part: the trailing part decides (hi + lo is not rounded).
+            let l = self.lo.floor();
+            let s = h + l;
+            Dd {
+                hi: s,
+                lo: l - (s - h),
+            }
+        } else {
+            Dd::exact(h)
+        }
+    }
+    #[inline]
+    fn pow2i(e: i32) -> Self {
+        Dd::exact(f64::pow2i(e))
+    }
+    #[inline]
+    fn rsqrt_guess(self) -> Self {
+        Dd::exact(Real::rsqrt_guess(self.hi))
     }
     #[inline]
     fn cbrt(self) -> Self {
@@ -351,7 +375,7 @@ impl ReferenceDim for Dim<3> {
     #[inline]
     fn method() -> OneSidedJacobi {
         OneSidedJacobi {
-            max_sweeps: REFERENCE_SWEEPS,
+            sweeps: REFERENCE_SWEEPS,
         }
     }
 }

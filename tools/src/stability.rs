@@ -36,9 +36,11 @@
 //! # Contracts checked ([`Report::violations`])
 //!
 //! Per case, from the family's [`Contract`] and the reference (the sign of `J` is the
-//! reference's): decompositions always succeed for finite `F` (finite, `U`, `V` orthonormal
-//! to `16ε` per entry with `det = +1`, `|σ|` sorted up to [`SORT_SLACK`]`·ε|σ₀|` plus twice
-//! the case's Σ error, only the last negative, `UΣVᵀ = F` to
+//! reference's; a reference SVD that misses [`BOUND_REFERENCE`], or reference kernels that
+//! refuse a `J > 0` not singular to working precision, is itself a violation, and what it
+//! would be compared with is not measured): decompositions always succeed for finite `F`
+//! (finite, `U`, `V` orthonormal to `16ε` per entry with `det = +1`, `|σ|` sorted up to
+//! [`SORT_SLACK`]`·ε|σ₀|` plus twice the case's Σ error, only the last negative, `UΣVᵀ = F` to
 //! [`BOUND_RECON`]`·ε‖F‖_F`, R and Σ errors within [`bound`]); kernels succeed for `J > 0`
 //! with errors within [`bound`], or return an error status only where `F` is singular to
 //! working precision (`4d·ε·κ_J ≥ 1`: the rounding error of the computed `det` can reach
@@ -55,6 +57,9 @@ use ampm_core::energy::FixedCorotated;
 use ampm_core::polar::{
     ClosedForm2, HighamNoferini, McAdams, OneSidedJacobi, QrSvd, Svd, SvdMethod,
 };
+use ampm_core::kernel::batch::{self as kbatch, BatchReal};
+use ampm_core::kernel::{Dim as KDim, LaneDim};
+use ampm_core::lane::{Isa, IsaKind};
 use ampm_core::{Error, Mat, Matrix, Real};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -77,6 +82,17 @@ pub const BOUND_RECON: f64 = 256.0;
 /// ulps (harmless: every formula using `σ` is symmetric in equal values). An order violation
 /// beyond that would pair a `σ` with the wrong singular vectors.
 pub const SORT_SLACK: f64 = 8.0;
+
+/// Accuracy the reference SVD must reach at every case it is used for: `U`, `V` orthonormal to
+/// `BOUND_REFERENCE` per entry and `‖UΣVᵀ − F‖_F ≤ BOUND_REFERENCE·max(‖F‖_F, Dd::MIN_POSITIVE)`
+/// — the methods' backward-error bound [`BOUND_RECON`] in units of the double-double `ε`
+/// (`≈ 1.3e-29`), absolute below the double-double normal range (`2⁻⁹⁶⁹`, where its trailing
+/// word is subnormal). An SVD that meets it is the exact SVD of a matrix within `~1e-29‖F‖` of
+/// `F`, so it measures any `f64` error to 13 digits. The reference runs the core's own
+/// generic methods: where they break (a normalisation of a vector whose squared norm
+/// underflows, say) it breaks the same way and would agree with the method under test; this
+/// check turns that into a violation instead.
+pub const BOUND_REFERENCE: f64 = BOUND_RECON * Dd::EPSILON.hi;
 
 /// The measured quantities.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -397,6 +413,93 @@ where
     }
 }
 
+/// The fast batch kernels of `ampm_core::kernel` on one instruction set, one particle per call
+/// (a padded chunk of lanes): the instantiation the C batch calls run. The decomposition is
+/// the default method on lanes; the kernels each run alone, so each has its own status.
+struct Fast(Isa, &'static str);
+
+impl<T: BatchReal, const D: usize> Runner<T, D> for Fast
+where
+    KDim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    fn spec(&self) -> MethodSpec {
+        MethodSpec {
+            key: self.1,
+            sweeps: None,
+            dim: D,
+        }
+    }
+    fn svd(&self, f: &Mat<T, D>) -> ampm_core::Result<Svd<Mat<T, D>>> {
+        let mut u = [T::ZERO; 9];
+        let mut v = [T::ZERO; 9];
+        let mut s = [T::ZERO; 3];
+        let st = kbatch::svd::<T, D>(self.0, &f.cols.concat(), &mut u[..D * D], &mut s[..D], &mut v[..D * D])?;
+        st.result().map_err(|e| e.1)?;
+        let sigma: [T; D] = s[..D].try_into().expect("D values");
+        Ok(Svd {
+            u: Mat::from_col_major(&u[..D * D]).expect("d² entries"),
+            sigma,
+            v: Mat::from_col_major(&v[..D * D]).expect("d² entries"),
+        })
+    }
+    fn kernels(&self, f: &Mat<T, D>, z: &Mat<T, D>) -> ampm_core::Result<KernelOut<T, D>> {
+        let mu = [T::from_f64(MU)];
+        let (fv, zv) = (f.cols.concat(), z.cols.concat());
+        let one = |what: u8| -> ampm_core::Result<Vec<T>> {
+            let mut out = vec![T::ZERO; if what == 0 { 1 } else { D * D }];
+            let o = match what {
+                0 => kbatch::Outputs { energy: Some(&mut out), ..Default::default() },
+                1 => kbatch::Outputs { ahat: Some(&mut out), ..Default::default() },
+                _ => kbatch::Outputs { chat_z: Some(&mut out), ..Default::default() },
+            };
+            kbatch::ahat_chat_z::<T, D>(self.0, &mu, &fv, Some(&zv), o)?
+                .result()
+                .map_err(|e| e.1)?;
+            Ok(out)
+        };
+        let m = |v: Vec<T>| Mat::from_col_major(&v).expect("d² entries");
+        let (p, a, c) = (one(0), one(1), one(2));
+        // A check that fails for every kernel (F, J, μ) is the call's status, as for the
+        // generic runners; per-kernel statuses (overflow) stay per kernel.
+        match (&p, &a, &c) {
+            (Err(x), Err(y), Err(w)) if x == y && y == w => Err(*x),
+            _ => Ok((p.map(|v| v[0]), a.map(m), c.map(m))),
+        }
+    }
+}
+
+/// Scalars with fast batch kernels: the [`Fast`] runner of each instruction set of this CPU.
+trait FastPaths<const D: usize>: Real {
+    fn fast_runners() -> Vec<Box<dyn Runner<Self, D>>>;
+}
+
+macro_rules! fast_paths {
+    ($t:ty) => {
+        impl<const D: usize> FastPaths<D> for $t
+        where
+            KDim<D>: LaneDim<D>,
+            Mat<$t, D>: Matrix<Scalar = $t, Vector = [$t; D]>,
+        {
+            fn fast_runners() -> Vec<Box<dyn Runner<$t, D>>> {
+                Isa::available()
+                    .into_iter()
+                    .map(|isa| {
+                        let key = match isa.kind() {
+                            IsaKind::Scalar => "fast-scalar",
+                            IsaKind::Avx2 => "fast-avx2",
+                            IsaKind::Avx512 => "fast-avx512",
+                        };
+                        Box::new(Fast(isa, key)) as Box<dyn Runner<$t, D>>
+                    })
+                    .collect()
+            }
+        }
+    };
+}
+fast_paths!(f32);
+fast_paths!(f64);
+
 /// The methods of each dimension.
 trait MethodsOf<T: Real, const D: usize>
 where
@@ -406,9 +509,11 @@ where
     fn methods(all_sweeps: bool) -> Vec<Box<dyn Runner<T, D>>>;
 }
 
-impl<T: Real> MethodsOf<T, 2> for Dim<2> {
+impl<T: Real + FastPaths<2>> MethodsOf<T, 2> for Dim<2> {
     fn methods(_all_sweeps: bool) -> Vec<Box<dyn Runner<T, 2>>> {
-        vec![Box::new(With(ClosedForm2, None))]
+        let mut v: Vec<Box<dyn Runner<T, 2>>> = vec![Box::new(With(ClosedForm2, None))];
+        v.extend(T::fast_runners());
+        v
     }
 }
 
@@ -416,7 +521,7 @@ impl<T: Real> MethodsOf<T, 2> for Dim<2> {
 /// and on the Haar family, the default (4) elsewhere in the full size.
 pub const MCADAMS_SWEEPS: [u32; 3] = [2, 4, 8];
 
-impl<T: Real> MethodsOf<T, 3> for Dim<3> {
+impl<T: Real + FastPaths<3>> MethodsOf<T, 3> for Dim<3> {
     fn methods(all_sweeps: bool) -> Vec<Box<dyn Runner<T, 3>>> {
         let mut v: Vec<Box<dyn Runner<T, 3>>> =
             vec![Box::new(With(OneSidedJacobi::default(), None))];
@@ -427,6 +532,7 @@ impl<T: Real> MethodsOf<T, 3> for Dim<3> {
         }
         v.push(Box::new(With(QrSvd::default(), None)));
         v.push(Box::new(With(HighamNoferini::default(), None)));
+        v.extend(T::fast_runners());
         v
     }
 }
@@ -510,6 +616,11 @@ struct Scales {
     s_b: f64,
     /// `σ̂` (J > 0 only).
     sigma_hat: Vec<f64>,
+    /// `J > 0` (the sign of `∏σ`).
+    j_positive: bool,
+    /// The reference's kernels refused `F` although `J > 0` and `F` is not singular to
+    /// working precision (set by the caller): nothing to compare the kernels with.
+    reference_kernels_failed: bool,
 }
 
 fn scales<T: Real, const D: usize>(
@@ -530,11 +641,15 @@ where
     } else {
         f64::INFINITY
     };
-    // Hadamard ratio with the determinant from the reference σ (exact to ~1e-30).
-    let j: f64 = sigma.iter().product();
+    // Hadamard ratio with the determinant from the reference σ (exact to ~1e-30). It is
+    // invariant under F ↦ 2ᵉF: both products are formed after scaling σ and the columns by the
+    // power of two of σ₀, so neither over- nor underflows unless the σ themselves span more
+    // than the exponent range.
+    let e = s0.exponent();
+    let j: f64 = sigma.iter().map(|x| libm::scalbn(*x, -e)).product();
     let mut colprod = 1.0;
     for c in &f.cols {
-        colprod *= c.iter().map(|x| x * x).sum::<f64>().sqrt();
+        colprod *= norm_scaled(&c.map(|x| libm::scalbn(x, -e)));
     }
     let kappa_j = if j == 0.0 {
         f64::INFINITY
@@ -565,6 +680,8 @@ where
         kappa_k,
         s_b,
         sigma_hat: sh,
+        j_positive: j > 0.0,
+        reference_kernels_failed: false,
     }
 }
 
@@ -731,6 +848,11 @@ fn measure_case<T: Real, const D: usize>(
         }
     }
     // --- kernels -----------------------------------------------------------------------
+    if sc.reference_kernels_failed {
+        // Reported once per case by the caller.
+        cell.record(ce);
+        return;
+    }
     let k = run.kernels(&f, &z);
     match &k {
         Err(e) => status_of(*e, &mut cell.statuses),
@@ -903,6 +1025,40 @@ fn perm_right<const D: usize>(m: &Mat<Dd, D>, q: &Mat<f64, D>) -> Mat<Dd, D> {
     out
 }
 
+/// Why `svd`, a reference SVD of `f`, misses [`BOUND_REFERENCE`]; `None` if it meets it. The
+/// reconstruction is formed after scaling `F` and `σ` by the power of two that brings
+/// `max|Fᵢⱼ|` to `[0.5, 1)` (exact), so the double-double products neither overflow near
+/// `f64::MAX` nor lose their trailing word near the subnormal range.
+#[must_use]
+pub fn reference_error<const D: usize>(f: &Mat<f64, D>, svd: &Svd<Mat<Dd, D>>) -> Option<String>
+where
+    Mat<Dd, D>: Matrix<Scalar = Dd, Vector = [Dd; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64>,
+{
+    let id = Mat::<Dd, D>::identity();
+    let ou = (svd.u.transpose() * svd.u - id).max_abs().to_f64();
+    let ov = (svd.v.transpose() * svd.v - id).max_abs().to_f64();
+    let e = f.max_abs().exponent();
+    let fs = reference::to_dd(f).map(|x| x.scalbn(-e));
+    let scaled = Svd {
+        u: svd.u,
+        sigma: svd.sigma.map(|x| x.scalbn(-e)),
+        v: svd.v,
+    };
+    let rec = (scaled.reconstruct() - fs).norm_squared().sqrt().to_f64();
+    let floor = Dd::MIN_POSITIVE.scalbn(-e).to_f64();
+    let rel = rec / fs.norm_squared().sqrt().to_f64().max(floor);
+    let det_ok = svd.u.det() > Dd::ZERO && svd.v.det() > Dd::ZERO;
+    // Written so that a NaN anywhere fails.
+    let ok = ou <= BOUND_REFERENCE && ov <= BOUND_REFERENCE && rel <= BOUND_REFERENCE;
+    (!ok || !det_ok).then(|| {
+        format!(
+            "reference SVD not accurate (UᵀU − I: {ou:e}, VᵀV − I: {ov:e}, \
+             ‖UΣVᵀ − F‖/‖F‖: {rel:e}, bound {BOUND_REFERENCE:e}; det U, det V > 0: {det_ok})"
+        )
+    })
+}
+
 /// A unit-Frobenius random direction rounded to `T`.
 fn direction<T: Real, const D: usize>(rng: &mut Pcg64) -> Mat<f64, D> {
     let mut m = Mat::<f64, D>::ZERO;
@@ -968,6 +1124,16 @@ where
                     } else {
                         None
                     };
+                    if let Some(msg) = rf.as_ref().and_then(|r| reference_error(&case.f, &r.svd)) {
+                        // The reference's own method fails here: nothing can be measured.
+                        let fp = pad3(&case.f);
+                        for (cell, viol) in &mut fam_cells {
+                            viol.add(&fp, D, format!("{msg}: case not measured"));
+                            cell.n_cases += 1;
+                        }
+                        rep = None;
+                        continue;
+                    }
                     if let Some(r) = &rf {
                         rep = Some((index as u32, *r, z));
                     }
@@ -980,7 +1146,26 @@ where
                     .kernels
                     .as_ref()
                     .map(|k| k.sigma_hat.iter().map(|x| x.to_f64()).collect());
-                scales::<T, D>(&case.f, &s, sh.as_deref())
+                let mut sc = scales::<T, D>(&case.f, &s, sh.as_deref());
+                // The reference's kernels are the library's own generic ones run in
+                // double-double: refusing a J > 0 that is not singular to working precision
+                // is their failure, and would pass off the same failure of the method's
+                // kernels as the J ≤ 0 contract.
+                sc.reference_kernels_failed =
+                    r.kernels.is_none() && sc.j_positive && !sc.near_singular;
+                if sc.reference_kernels_failed {
+                    let fp = pad3(&case.f);
+                    for (_, viol) in &mut fam_cells {
+                        viol.add(
+                            &fp,
+                            D,
+                            "reference kernels refused J > 0 (not singular to working \
+                             precision): kernels not measured"
+                                .into(),
+                        );
+                    }
+                }
+                sc
             });
             for (r, (cell, viol)) in runners.iter().zip(fam_cells.iter_mut()) {
                 measure_case::<T, D>(r.as_ref(), fam.contract(), case, &z, &rf, &sc, cell, viol);
@@ -1000,13 +1185,13 @@ pub trait Measure<T: Real> {
     fn measure(size: Size, families: &[Family], cells: &mut Vec<Cell>);
 }
 
-impl<T: Real> Measure<T> for Dim<2> {
+impl<T: Real + FastPaths<2>> Measure<T> for Dim<2> {
     fn measure(size: Size, families: &[Family], cells: &mut Vec<Cell>) {
         run_dim::<T, 2>(size, families, cells);
     }
 }
 
-impl<T: Real> Measure<T> for Dim<3> {
+impl<T: Real + FastPaths<3>> Measure<T> for Dim<3> {
     fn measure(size: Size, families: &[Family], cells: &mut Vec<Cell>) {
         run_dim::<T, 3>(size, families, cells);
     }

@@ -268,3 +268,43 @@ pub fn cast_particles<T: ampm_core::Real, const D: usize>(
 ) -> Vec<(Mat<T, D>, Mat<T, D>)> {
     parts.iter().map(|(f, z)| (f.cast(), z.cast())).collect()
 }
+
+/// Smallest singular value of the batch workload of `c_tests/bench_kernels` (and of the
+/// `batch` bench and the report's fast-path timings, which reproduce its distribution).
+pub const BATCH_SIGMA_MIN: f64 = 0.5;
+/// Largest singular value of that workload.
+pub const BATCH_SIGMA_MAX: f64 = 2.0;
+
+/// `n` particles in the distribution of `c_tests/bench_kernels` (not its draws: that program
+/// has its own generator), flattened for the batch calls: `(μ, F, Z)` with `μ = 1`,
+/// `F = R₁ diag(σ) R₂ᵀ`, σᵢ log-uniform in [[`BATCH_SIGMA_MIN`], [`BATCH_SIGMA_MAX`]], `R₁`, `R₂`
+/// Haar on `SO(d)`, `Z` entries uniform in `[−1, 1]`; drawn in `f64` from stream `stream` and
+/// rounded to `T`; `d²` column-major scalars per particle.
+#[must_use]
+pub fn batch_workload<T: ampm_core::Real, const D: usize>(
+    n: usize,
+    stream: u64,
+) -> (Vec<T>, Vec<T>, Vec<T>)
+where
+    Mat<f64, D>: HaarRotation,
+{
+    let mut r = rng(stream);
+    let (lo, hi) = (BATCH_SIGMA_MIN.ln(), BATCH_SIGMA_MAX.ln());
+    let (mut f, mut z) = (Vec::with_capacity(n * D * D), Vec::with_capacity(n * D * D));
+    for _ in 0..n {
+        let mut sigma = [0.0; D];
+        for s in &mut sigma {
+            *s = r.random_range(lo..hi).exp();
+        }
+        let fm = <Mat<f64, D>>::haar(&mut r)
+            * Mat::from_diagonal(sigma)
+            * <Mat<f64, D>>::haar(&mut r).transpose();
+        for j in 0..D {
+            for i in 0..D {
+                f.push(T::from_f64(fm.cols[j][i]));
+                z.push(T::from_f64(r.random_range(-1.0..1.0)));
+            }
+        }
+    }
+    (vec![T::ONE; n], f, z)
+}

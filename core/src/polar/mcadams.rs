@@ -35,8 +35,15 @@
 #![allow(clippy::needless_range_loop)]
 
 use super::{Svd, SvdMethod};
-use crate::batch::lane::Lane;
-use crate::batch::lmat::{scale_exponent, scale_pow2, scale_pow2_scalar, LMat};
+use crate::lane::lmat::{max_abs, pow2_factors, scale_pow2, LMat};
+use crate::lane::Lane;
+
+/// `x · 2ᵉ` (as [`scale_pow2`] on one entry).
+#[inline(always)]
+fn scale_pow2_scalar<S: Lane>(x: S, e: S) -> S {
+    let [p1, p2, p3] = pow2_factors(e);
+    x * p1 * p2 * p3
+}
 use crate::error::{Error, Result};
 use crate::mat::Mat;
 use crate::scalar::Real;
@@ -218,7 +225,7 @@ fn svd3_lanes<S: Lane>(f0: &LMat<S, 3>, sweeps: u32) -> (LMat<S, 3>, [S; 3], LMa
     let zero = S::splat(S::Scalar::ZERO);
     let one = S::splat(S::Scalar::ONE);
     let two = S::splat(S::Scalar::TWO);
-    let k = scale_exponent(f0);
+    let k = max_abs(f0).exponent();
     let g = scale_pow2(f0, -k);
     // S = GᵀG (entries are dot products of columns).
     let mut s00 = dot3(&g[0], &g[0]);

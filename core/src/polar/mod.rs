@@ -22,14 +22,15 @@
 
 mod closed_form_2d;
 mod higham_noferini;
+pub mod lanes;
 mod mcadams;
 mod one_sided_jacobi;
 mod qr_svd;
 
-pub use closed_form_2d::ClosedForm2;
+pub use closed_form_2d::{closed_form_2d, normalize2, ClosedForm2};
 pub use higham_noferini::HighamNoferini;
 pub use mcadams::McAdams;
-pub use one_sided_jacobi::OneSidedJacobi;
+pub use one_sided_jacobi::{one_sided_jacobi, OneSidedJacobi};
 pub use qr_svd::QrSvd;
 
 use crate::error::Result;

@@ -12,9 +12,11 @@
 //!   with four Givens rotations per sweep.
 //! - §3.1 (deflation): when `|β₁|` or `|β₀|` is below the tolerance the problem splits into a
 //!   1×1 and a 2×2 block; the 2×2 block is solved in closed form (here by [`ClosedForm2`], the
-//!   same polar-based construction as the paper's §4). When a diagonal `|αᵢ|` is below the
-//!   tolerance it is set to zero and its row (or, for `α₂`, its column) is chased out with two
-//!   Givens rotations (Golub & Van Loan §8.6.2), which makes a `β` exactly zero.
+//!   same polar-based construction as the paper's §4; a negligible `β` of that block is
+//!   deflated first, so the closed form never squares an off-diagonal that is tiny relative to
+//!   its block). When a diagonal `|αᵢ|` is below the tolerance it is set to zero and its row
+//!   (or, for `α₂`, its column) is chased out with two Givens rotations (Golub & Van Loan
+//!   §8.6.2), which makes a `β` exactly zero.
 //! - §5 (sign and order): the rotation-variant convention of [`crate::polar`] by
 //!   [`rotation_variant`].
 //!
@@ -320,6 +322,15 @@ impl<T: Real> SvdMethod<Mat<T, 3>> for QrSvd {
             let b = &st.b;
             if b[(1, 2)].abs() <= tol {
                 st.b[(1, 2)] = T::ZERO;
+                // A negligible β₀ is deflated too (the same backward error, ≤ ε‖G‖, as one
+                // rounding of G) instead of being left to the 2×2 closed form, which would
+                // square an off-diagonal of relative size below √MIN_POSITIVE into the
+                // subnormal range. The norms it takes of the block [[α₀, β₀], [0, α₁]],
+                // σ₀ + σ₁ = ‖(α₀ + α₁, β₀)‖ and σ₀ − σ₁ = ‖(α₀ − α₁, β₀)‖, are ≥ |β₀| > ε‖G‖
+                // for any β₀ kept, far above that range.
+                if st.b[(0, 1)].abs() <= tol {
+                    st.b[(0, 1)] = T::ZERO;
+                }
                 break st.finish(0, 2)?;
             }
             if b[(0, 1)].abs() <= tol {

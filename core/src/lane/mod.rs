@@ -1,0 +1,503 @@
+//! Lanes: one source of arithmetic for a scalar and for a SIMD vector of scalars.
+//!
+//! The default decompositions ([`crate::polar::ClosedForm2`], [`crate::polar::OneSidedJacobi`])
+//! and the SVD-basis kernels of fixed corotated Ψ̂ ([`crate::kernel`]) are written once, generic
+//! over [`Lane`], and contain no data-dependent branch: every choice is a [`Lane::select`] on a
+//! mask. The same source runs
+//! - on one `f32` or `f64` ([`Lane`] is implemented for every [`Real`]): the single-particle
+//!   API, and the only form on targets without SIMD (`no_std`, `thumbv7em-none-eabihf`);
+//! - on x86-64 vectors (`x86` module, crate-private): `f32×8`/`f64×4` with AVX2+FMA and
+//!   `f32×16`/`f64×8` with AVX-512F. They are reachable only through the batch entry points
+//!   of [`crate::kernel`], which take an [`Isa`] that proves the CPU supports them.
+//!
+//! **Same bits on every path.** Every lane operation is an IEEE-754 operation that is
+//! correctly rounded on every path: `+ − × ÷`, `sqrt`, `floor`, and exact bit manipulations
+//! (`abs`, `copysign`, [`Lane::exponent`], [`Lane::pow2`], the integer seed
+//! [`Lane::rsqrt_guess`] of the Newton iterations in [`lmat`]). The hardware's approximate
+//! `rsqrt`/`rcp` instructions are not used: their bits differ between AVX2 and AVX-512. There is deliberately no fused
+//! multiply-add: on a scalar without an FMA instruction it is a ~6 ns software routine, and
+//! Rust never contracts `a·b + c` by itself. So a lane of a vector result has exactly the bits
+//! of the scalar result, on AVX2, AVX-512 and any other target (tested in `tests/batch.rs`).
+
+use crate::scalar::Real;
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
+
+pub mod lmat;
+#[cfg(target_arch = "x86_64")]
+mod x86;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use x86::{F32x16, F32x8, F64x4, F64x8};
+
+/// A scalar or a SIMD vector of scalars with lane-wise arithmetic, comparisons and selection.
+pub trait Lane:
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + Send
+    + Sync
+    + 'static
+{
+    /// The element type.
+    type Scalar: Real;
+    /// Lane-wise booleans.
+    type Mask: Copy
+        + Debug
+        + BitAnd<Output = Self::Mask>
+        + BitOr<Output = Self::Mask>
+        + Not<Output = Self::Mask>;
+    /// Number of lanes.
+    const LANES: usize;
+
+    /// Every lane `x`.
+    #[must_use]
+    fn splat(x: Self::Scalar) -> Self;
+    /// Lanes `s[0..LANES]` (`s.len() ≥ LANES`).
+    #[must_use]
+    fn load(s: &[Self::Scalar]) -> Self;
+    /// Writes the lanes to `s[0..LANES]` (`s.len() ≥ LANES`).
+    fn store(self, s: &mut [Self::Scalar]);
+    /// Lane `i` from `*base.add(i·stride)` (a hardware gather on the vector paths).
+    ///
+    /// # Safety
+    /// Every `base.add(i·stride)`, `i < LANES`, is valid for reading; `i·stride < 2³¹`.
+    #[must_use]
+    unsafe fn gather(base: *const Self::Scalar, stride: usize) -> Self;
+    /// Writes lane `i` to `*base.add(i·stride)` for every `i` with bit `i` of `keep` set.
+    ///
+    /// # Safety
+    /// Every such `base.add(i·stride)` is valid for writing; `i·stride < 2³¹`.
+    unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32);
+    /// `self·a + b`: fused (one rounding) on the SIMD paths, which all have an FMA
+    /// instruction; two roundings on scalars (a software FMA costs ~6 ns without one).
+    #[must_use]
+    fn mul_add(self, a: Self, b: Self) -> Self;
+    /// Correctly rounded square root.
+    #[must_use]
+    fn sqrt(self) -> Self;
+    /// Absolute value (clears the sign bit).
+    #[must_use]
+    fn abs(self) -> Self;
+    /// Magnitude of `self` with the sign bit of `sign`.
+    #[must_use]
+    fn copysign(self, sign: Self) -> Self;
+    /// Largest integer not above `self`.
+    #[must_use]
+    fn floor(self) -> Self;
+    /// [`Real::rsqrt_guess`] lane-wise (the same integer operation on every path).
+    #[must_use]
+    fn rsqrt_guess(self) -> Self;
+    /// `if m { a } else { b }`, lane-wise.
+    #[must_use]
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// `self < o` (false for NaN).
+    #[must_use]
+    fn lt(self, o: Self) -> Self::Mask;
+    /// `self ≤ o` (false for NaN).
+    #[must_use]
+    fn le(self, o: Self) -> Self::Mask;
+    /// `self == o` (false for NaN).
+    #[must_use]
+    fn eq(self, o: Self) -> Self::Mask;
+    /// Neither NaN nor infinite.
+    #[must_use]
+    fn is_finite(self) -> Self::Mask;
+    /// Bit `i` set when lane `i` of `m` is true.
+    #[must_use]
+    fn mask_bits(m: Self::Mask) -> u32;
+    /// Binary exponent `e` with `self = m·2ᵉ`, `0.5 ≤ |m| < 1` (0 for zero or non-finite), as
+    /// an integer-valued lane; exact for subnormals too (as `frexp`).
+    #[must_use]
+    fn exponent(self) -> Self;
+    /// `2ᵉ` for an integer-valued `e` in the normal range `[1 − bias, bias]`, built from the
+    /// exponent field (exact).
+    #[must_use]
+    fn pow2(e: Self) -> Self;
+
+    /// `1/√self` for a positive normal `self`, to a few ulps. Vector paths: the Newton
+    /// iteration [`lmat::rsqrt_newton`] (no division or square-root instruction, whose
+    /// throughput would dominate the kernels); scalars: `1/√x` with the correctly rounded
+    /// instructions (lower latency for one particle, and within one ulp of each rounding).
+    #[inline(always)]
+    #[must_use]
+    fn rsqrt(self) -> Self {
+        lmat::rsqrt_newton(self)
+    }
+    /// `1/self` for a positive normal `self`: `rsqrt(x)²` on the vector paths, a correctly
+    /// rounded division on scalars.
+    #[inline(always)]
+    #[must_use]
+    fn recip(self) -> Self {
+        let r = self.rsqrt();
+        r * r
+    }
+    /// The larger of two lanes (`o` where either is NaN: callers mask NaN separately).
+    #[inline(always)]
+    #[must_use]
+    fn max(self, o: Self) -> Self {
+        Self::select(o.lt(self), self, o)
+    }
+    /// The smaller of two lanes.
+    #[inline(always)]
+    #[must_use]
+    fn min(self, o: Self) -> Self {
+        Self::select(self.lt(o), self, o)
+    }
+    /// Every lane of `m` true.
+    #[inline(always)]
+    #[must_use]
+    fn all(m: Self::Mask) -> bool {
+        Self::mask_bits(m) == (u32::MAX >> (32 - Self::LANES as u32))
+    }
+    /// Some lane of `m` true.
+    #[inline(always)]
+    #[must_use]
+    fn any(m: Self::Mask) -> bool {
+        Self::mask_bits(m) != 0
+    }
+}
+
+/// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
+/// (`libm`), so this is also what `no_std` targets run.
+impl<T: Real> Lane for T {
+    type Scalar = T;
+    type Mask = bool;
+    const LANES: usize = 1;
+
+    #[inline(always)]
+    fn splat(x: T) -> T {
+        x
+    }
+    #[inline(always)]
+    fn load(s: &[T]) -> T {
+        s[0]
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [T]) {
+        s[0] = self;
+    }
+    #[inline(always)]
+    unsafe fn gather(base: *const T, _stride: usize) -> T {
+        base.read_unaligned()
+    }
+    #[inline(always)]
+    unsafe fn scatter(self, base: *mut T, _stride: usize, keep: u32) {
+        if keep & 1 == 1 {
+            base.write_unaligned(self);
+        }
+    }
+    #[inline(always)]
+    fn mul_add(self, a: T, b: T) -> T {
+        self * a + b
+    }
+    #[inline(always)]
+    fn sqrt(self) -> T {
+        Real::sqrt(self)
+    }
+    #[inline(always)]
+    fn abs(self) -> T {
+        Real::abs(self)
+    }
+    #[inline(always)]
+    fn copysign(self, sign: T) -> T {
+        Real::copysign(self, sign)
+    }
+    #[inline(always)]
+    fn floor(self) -> T {
+        Real::floor(self)
+    }
+    #[inline(always)]
+    fn rsqrt_guess(self) -> T {
+        Real::rsqrt_guess(self)
+    }
+    #[inline(always)]
+    fn rsqrt(self) -> T {
+        T::ONE / Real::sqrt(self)
+    }
+    #[inline(always)]
+    fn recip(self) -> T {
+        T::ONE / self
+    }
+    #[inline(always)]
+    fn select(m: bool, a: T, b: T) -> T {
+        if m {
+            a
+        } else {
+            b
+        }
+    }
+    #[inline(always)]
+    fn lt(self, o: T) -> bool {
+        self < o
+    }
+    #[inline(always)]
+    fn le(self, o: T) -> bool {
+        self <= o
+    }
+    #[inline(always)]
+    fn eq(self, o: T) -> bool {
+        self == o
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        Real::is_finite(self)
+    }
+    #[inline(always)]
+    fn mask_bits(m: bool) -> u32 {
+        u32::from(m)
+    }
+    #[inline(always)]
+    fn exponent(self) -> T {
+        T::from_i32(Real::exponent(self))
+    }
+    #[inline(always)]
+    fn pow2(e: T) -> T {
+        T::pow2i(e.to_f64() as i32)
+    }
+}
+
+/// The instruction sets of the batch kernels, widest first. A value other than
+/// [`Isa::Scalar`] is a promise that the CPU supports it: create it with [`Isa::detect`] (with
+/// the `std` feature) or, unsafely, with [`Isa::assume`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Isa(IsaKind);
+
+/// What an [`Isa`] names.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum IsaKind {
+    /// One particle at a time (`f32`/`f64` lanes); every target.
+    Scalar,
+    /// x86-64 AVX2 + FMA: `f32×8`, `f64×4`.
+    Avx2,
+    /// x86-64 AVX-512F (+ AVX2 + FMA): `f32×16`, `f64×8`.
+    Avx512,
+}
+
+impl Isa {
+    /// The scalar path, available everywhere.
+    pub const SCALAR: Isa = Isa(IsaKind::Scalar);
+
+    /// What this value names.
+    #[inline]
+    #[must_use]
+    pub fn kind(self) -> IsaKind {
+        self.0
+    }
+
+    /// Short name for reports: "scalar", "avx2", "avx512".
+    #[inline]
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self.0 {
+            IsaKind::Scalar => "scalar",
+            IsaKind::Avx2 => "avx2",
+            IsaKind::Avx512 => "avx512",
+        }
+    }
+
+    /// An [`Isa`] of the given kind without checking the CPU.
+    ///
+    /// # Safety
+    /// The CPU running every kernel called with the result must support the kind's
+    /// instructions (AVX2 and FMA; for [`IsaKind::Avx512`] also AVX-512F).
+    #[inline]
+    #[must_use]
+    pub const unsafe fn assume(kind: IsaKind) -> Isa {
+        Isa(kind)
+    }
+
+    /// The widest instruction set of this CPU (detected at run time).
+    #[cfg(feature = "std")]
+    #[inline]
+    #[must_use]
+    pub fn detect() -> Isa {
+        Self::available().last().copied().unwrap_or(Isa::SCALAR)
+    }
+
+    /// Every instruction set this CPU supports, scalar first (for tests and benchmarks).
+    #[cfg(feature = "std")]
+    #[must_use]
+    pub fn available() -> std::vec::Vec<Isa> {
+        let mut v = std::vec![Isa::SCALAR];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                v.push(Isa(IsaKind::Avx2));
+                if std::is_x86_feature_detected!("avx512f") {
+                    v.push(Isa(IsaKind::Avx512));
+                }
+            }
+        }
+        v
+    }
+}
+
+/// Two vectors processed as one lane type of twice the width: every operation is issued on
+/// both halves, which are independent, so the long dependency chains of the kernels (a
+/// Jacobi rotation waits for its Newton square roots) overlap and the core's pipelines stay
+/// full. Same bits as the halves alone.
+#[derive(Clone, Copy, Debug)]
+pub struct X2<V>(pub [V; 2]);
+
+/// The mask of [`X2`].
+#[derive(Clone, Copy, Debug)]
+pub struct X2Mask<M>(pub [M; 2]);
+
+impl<M: Copy + BitAnd<Output = M>> BitAnd for X2Mask<M> {
+    type Output = Self;
+    #[inline(always)]
+    fn bitand(self, o: Self) -> Self {
+        X2Mask([self.0[0] & o.0[0], self.0[1] & o.0[1]])
+    }
+}
+impl<M: Copy + BitOr<Output = M>> BitOr for X2Mask<M> {
+    type Output = Self;
+    #[inline(always)]
+    fn bitor(self, o: Self) -> Self {
+        X2Mask([self.0[0] | o.0[0], self.0[1] | o.0[1]])
+    }
+}
+impl<M: Copy + Not<Output = M>> Not for X2Mask<M> {
+    type Output = Self;
+    #[inline(always)]
+    fn not(self) -> Self {
+        X2Mask([!self.0[0], !self.0[1]])
+    }
+}
+
+macro_rules! x2_binop {
+    ($tr:ident, $f:ident, $tra:ident, $fa:ident, $op:tt) => {
+        impl<V: Lane> $tr for X2<V> {
+            type Output = Self;
+            #[inline(always)]
+            fn $f(self, o: Self) -> Self {
+                X2([self.0[0] $op o.0[0], self.0[1] $op o.0[1]])
+            }
+        }
+        impl<V: Lane> $tra for X2<V> {
+            #[inline(always)]
+            fn $fa(&mut self, o: Self) {
+                *self = *self $op o;
+            }
+        }
+    };
+}
+x2_binop!(Add, add, AddAssign, add_assign, +);
+x2_binop!(Sub, sub, SubAssign, sub_assign, -);
+x2_binop!(Mul, mul, MulAssign, mul_assign, *);
+
+impl<V: Lane> Div for X2<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(self, o: Self) -> Self {
+        X2([self.0[0] / o.0[0], self.0[1] / o.0[1]])
+    }
+}
+impl<V: Lane> Neg for X2<V> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        X2([-self.0[0], -self.0[1]])
+    }
+}
+
+impl<V: Lane> Lane for X2<V> {
+    type Scalar = V::Scalar;
+    type Mask = X2Mask<V::Mask>;
+    const LANES: usize = 2 * V::LANES;
+
+    #[inline(always)]
+    fn splat(x: Self::Scalar) -> Self {
+        X2([V::splat(x); 2])
+    }
+    #[inline(always)]
+    fn load(s: &[Self::Scalar]) -> Self {
+        X2([V::load(s), V::load(&s[V::LANES..])])
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [Self::Scalar]) {
+        self.0[0].store(s);
+        self.0[1].store(&mut s[V::LANES..]);
+    }
+    #[inline(always)]
+    unsafe fn gather(base: *const Self::Scalar, stride: usize) -> Self {
+        X2([
+            V::gather(base, stride),
+            V::gather(base.add(V::LANES * stride), stride),
+        ])
+    }
+    #[inline(always)]
+    unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32) {
+        self.0[0].scatter(base, stride, keep);
+        self.0[1].scatter(base.add(V::LANES * stride), stride, keep >> V::LANES);
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        X2([
+            self.0[0].mul_add(a.0[0], b.0[0]),
+            self.0[1].mul_add(a.0[1], b.0[1]),
+        ])
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        X2([self.0[0].sqrt(), self.0[1].sqrt()])
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        X2([self.0[0].abs(), self.0[1].abs()])
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        X2([self.0[0].copysign(sign.0[0]), self.0[1].copysign(sign.0[1])])
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        X2([self.0[0].floor(), self.0[1].floor()])
+    }
+    #[inline(always)]
+    fn rsqrt_guess(self) -> Self {
+        X2([self.0[0].rsqrt_guess(), self.0[1].rsqrt_guess()])
+    }
+    #[inline(always)]
+    fn select(m: Self::Mask, a: Self, b: Self) -> Self {
+        X2([
+            V::select(m.0[0], a.0[0], b.0[0]),
+            V::select(m.0[1], a.0[1], b.0[1]),
+        ])
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> Self::Mask {
+        X2Mask([self.0[0].lt(o.0[0]), self.0[1].lt(o.0[1])])
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> Self::Mask {
+        X2Mask([self.0[0].le(o.0[0]), self.0[1].le(o.0[1])])
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> Self::Mask {
+        X2Mask([self.0[0].eq(o.0[0]), self.0[1].eq(o.0[1])])
+    }
+    #[inline(always)]
+    fn is_finite(self) -> Self::Mask {
+        X2Mask([self.0[0].is_finite(), self.0[1].is_finite()])
+    }
+    #[inline(always)]
+    fn mask_bits(m: Self::Mask) -> u32 {
+        V::mask_bits(m.0[0]) | V::mask_bits(m.0[1]) << V::LANES
+    }
+    #[inline(always)]
+    fn exponent(self) -> Self {
+        X2([self.0[0].exponent(), self.0[1].exponent()])
+    }
+    #[inline(always)]
+    fn pow2(e: Self) -> Self {
+        X2([V::pow2(e.0[0]), V::pow2(e.0[1])])
+    }
+}

@@ -1,0 +1,87 @@
+//! What the branch-free decompositions share: the SVD of lanes, the exact power-of-two input
+//! scaling, and scaled norms.
+
+use super::Svd;
+use crate::lane::lmat::{c, max_abs, pow2_factors, renormalize, rsqrt, scale_pow2, LMat};
+use crate::lane::Lane;
+use crate::mat::Mat;
+use crate::scalar::Real;
+
+/// A rotation-variant SVD `U diag(σ) Vᵀ` of lanes (conventions of [`crate::polar`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LSvd<V, const D: usize> {
+    /// Left rotation.
+    pub u: LMat<V, D>,
+    /// Singular values, decreasing in magnitude; only the last may be negative.
+    pub sigma: [V; D],
+    /// Right rotation.
+    pub v: LMat<V, D>,
+}
+
+impl<V: Lane, const D: usize> LSvd<V, D> {
+    /// The SVD of `2ᵏ G` from that of `G`: `σ · 2ᵏ`.
+    #[inline(always)]
+    #[must_use]
+    pub fn unscaled(mut self, k: V) -> Self {
+        let [p1, p2, p3] = pow2_factors(k);
+        for s in &mut self.sigma {
+            *s = *s * p1 * p2 * p3;
+        }
+        self
+    }
+}
+
+impl<T: Real, const D: usize> From<LSvd<T, D>> for Svd<Mat<T, D>>
+where
+    Mat<T, D>: crate::Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline]
+    fn from(s: LSvd<T, D>) -> Self {
+        Svd {
+            u: Mat::from_cols(s.u),
+            sigma: s.sigma,
+            v: Mat::from_cols(s.v),
+        }
+    }
+}
+
+/// `(G, k)` with `F = 2ᵏ G` and `G`'s largest entry in `[0.5, 1)` (exact; `k = 0`, `G = 0`
+/// for `F = 0`). `F` must be finite.
+#[inline(always)]
+#[must_use]
+pub fn scaled_input<V: Lane, const D: usize>(f: &LMat<V, D>) -> (LMat<V, D>, V) {
+    let k = max_abs(f).exponent();
+    (scale_pow2(f, -k), k)
+}
+
+/// `(a/‖a‖, ‖a‖)`, computed on `a·2⁻ᵉ` with `2ᵉ` the power of two of `a`'s largest entry
+/// (exact), so no square under- or overflows. `(a, 0)` for `a = 0`.
+#[inline(always)]
+#[must_use]
+pub fn normalize<V: Lane, const D: usize>(a: &[V; D]) -> ([V; D], V) {
+    let mut m = a[0].abs();
+    for x in a.iter().skip(1) {
+        m = m.max(x.abs());
+    }
+    let e = m.exponent();
+    let h = (e * c(0.5)).floor();
+    let (p1, p2) = (V::pow2(-h), V::pow2(h - e));
+    let mut s = *a;
+    for x in &mut s {
+        *x = *x * p1 * p2;
+    }
+    let mut n2 = s[0] * s[0];
+    for x in s.iter().skip(1) {
+        n2 += *x * *x;
+    }
+    let zero = m.eq(c(0.0));
+    // n2 ∈ [1/4, D] after the scaling: a Newton reciprocal square root is accurate there.
+    let inv = rsqrt(V::select(zero, c(1.0), n2));
+    let n = n2 * inv;
+    for x in &mut s {
+        *x *= inv;
+    }
+    let s = renormalize(s);
+    let norm = n * V::pow2(h) * V::pow2(e - h);
+    (s, V::select(zero, c(0.0), norm))
+}

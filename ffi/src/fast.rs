@@ -1,0 +1,217 @@
+//! Generic bodies of the entry points that run on the fast kernels of `ampm_core::kernel`
+//! (fixed corotated, default decomposition): the batch calls on the widest instruction set of
+//! the CPU (detected once, or chosen with `ampm_set_isa`), the single-particle calls on the
+//! scalar instantiation of the same source.
+
+use crate::abi::guard;
+use crate::status::AmpmStatus;
+use ampm_core::kernel::batch::{
+    apply_raw, kernels_raw, prepare_raw, ApplyArgs, BatchReal, BatchStatus, KernelArgs, PrepareArgs,
+};
+use ampm_core::kernel::{prepared, Dim, LaneDim};
+use ampm_core::lane::{Isa, IsaKind};
+use core::ptr;
+use std::sync::atomic::{AtomicU8, Ordering};
+
+/// The instruction set of the batch calls: 0 = not chosen yet, else `1 + AMPM_ISA_*`.
+static ISA: AtomicU8 = AtomicU8::new(0);
+
+/// `AMPM_ISA_*` value of an [`IsaKind`].
+fn code(k: IsaKind) -> u32 {
+    match k {
+        IsaKind::Scalar => 0,
+        IsaKind::Avx2 => 1,
+        IsaKind::Avx512 => 2,
+    }
+}
+
+/// The instruction set the batch calls use: the widest this CPU supports, detected on first
+/// use, unless `ampm_set_isa` chose another.
+pub(crate) fn isa() -> Isa {
+    let c = ISA.load(Ordering::Relaxed);
+    let all = Isa::available();
+    if c == 0 {
+        let best = *all.last().unwrap_or(&Isa::SCALAR);
+        ISA.store(code(best.kind()) as u8 + 1, Ordering::Relaxed);
+        return best;
+    }
+    all.into_iter()
+        .find(|i| code(i.kind()) + 1 == u32::from(c))
+        .unwrap_or(Isa::SCALAR)
+}
+
+/// Body of `ampm_set_isa`.
+pub(crate) fn set_isa(isa: u32) -> AmpmStatus {
+    match Isa::available().into_iter().find(|i| code(i.kind()) == isa) {
+        Some(i) => {
+            ISA.store(code(i.kind()) as u8 + 1, Ordering::Relaxed);
+            AmpmStatus::AMPM_OK
+        }
+        None => AmpmStatus::AMPM_ERR_INVALID_ARGUMENT,
+    }
+}
+
+/// Body of `ampm_isa`.
+pub(crate) fn current_isa() -> u32 {
+    code(isa().kind())
+}
+
+/// `n` records of `w` scalars of `T` are addressable.
+fn size_ok<T>(n: usize, w: usize) -> bool {
+    n.checked_mul(w * core::mem::size_of::<T>())
+        .is_some_and(|b| b <= isize::MAX as usize)
+}
+
+/// Writes `*first_failed` (when non-null) and turns the outcome into a status.
+///
+/// # Safety
+/// `first_failed` null or valid for writing.
+unsafe fn finish(st: BatchStatus, first_failed: *mut usize) -> AmpmStatus {
+    if !first_failed.is_null() {
+        *first_failed = st.first_failed;
+    }
+    st.error.map_or(AmpmStatus::AMPM_OK, Into::into)
+}
+
+/// A batch of the kernels: `Â`, `Ĉ:Z`/`Ĉ⁺:Z`, `Ψ̂`, each output optional (null), at least one
+/// requested; `z` required with `chat_z`.
+///
+/// # Safety
+/// Non-null pointers valid for `n` records.
+#[allow(clippy::too_many_arguments)]
+pub(crate) unsafe fn kernels<T: BatchReal, const D: usize>(
+    isa: Isa,
+    n: usize,
+    mu: *const T,
+    f: *const T,
+    z: *const T,
+    ahat: *mut T,
+    chat_z: *mut T,
+    energy: *mut T,
+    psd: bool,
+    first_failed: *mut usize,
+) -> AmpmStatus
+where
+    Dim<D>: LaneDim<D>,
+{
+    guard(|| {
+        let no_output = ahat.is_null() && chat_z.is_null() && energy.is_null();
+        if n > 0 && (no_output || mu.is_null() || f.is_null() || (!chat_z.is_null() && z.is_null()))
+        {
+            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+        }
+        if !size_ok::<T>(n, D * D) {
+            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+        }
+        let args = KernelArgs {
+            n,
+            mu,
+            f,
+            z,
+            ahat,
+            chat_z,
+            energy,
+            psd,
+        };
+        finish(kernels_raw::<T, D>(isa, args), first_failed)
+    })
+}
+
+/// One particle through the scalar instantiation: `Â`, `Ĉ:Z`/`Ĉ⁺:Z` or `Ψ̂` (exactly one
+/// output non-null). Writes only on success.
+///
+/// # Safety
+/// Non-null pointers valid for one record.
+#[allow(clippy::too_many_arguments)]
+pub(crate) unsafe fn single<T: BatchReal, const D: usize>(
+    mu: T,
+    f: *const T,
+    z: *const T,
+    ahat: *mut T,
+    chat_z: *mut T,
+    energy: *mut T,
+    psd: bool,
+) -> AmpmStatus
+where
+    Dim<D>: LaneDim<D>,
+{
+    let mu = [mu];
+    kernels::<T, D>(
+        Isa::SCALAR,
+        1,
+        mu.as_ptr(),
+        f,
+        z,
+        ahat,
+        chat_z,
+        energy,
+        psd,
+        ptr::null_mut(),
+    )
+}
+
+/// Body of `ampm_hessian_prepare_batch_*`.
+///
+/// # Safety
+/// Non-null pointers valid for `n` records.
+pub(crate) unsafe fn prepare<T: BatchReal, const D: usize>(
+    n: usize,
+    mu: *const T,
+    f: *const T,
+    ahat: *mut T,
+    prep: *mut T,
+    first_failed: *mut usize,
+) -> AmpmStatus
+where
+    Dim<D>: LaneDim<D>,
+{
+    guard(|| {
+        if n > 0 && (mu.is_null() || f.is_null() || prep.is_null()) {
+            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+        }
+        if !size_ok::<T>(n, prepared::len(D)) {
+            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+        }
+        let args = PrepareArgs {
+            n,
+            mu,
+            f,
+            ahat,
+            prepared: prep,
+        };
+        finish(prepare_raw::<T, D>(isa(), args), first_failed)
+    })
+}
+
+/// Body of `ampm_hessian_apply_batch_*`.
+///
+/// # Safety
+/// Non-null pointers valid for `n` records.
+pub(crate) unsafe fn apply<T: BatchReal, const D: usize>(
+    n: usize,
+    prep: *const T,
+    z: *const T,
+    out: *mut T,
+    psd: bool,
+    first_failed: *mut usize,
+) -> AmpmStatus
+where
+    Dim<D>: LaneDim<D>,
+{
+    guard(|| {
+        if n > 0 && (prep.is_null() || z.is_null() || out.is_null()) {
+            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+        }
+        if !size_ok::<T>(n, prepared::len(D)) {
+            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+        }
+        let args = ApplyArgs {
+            n,
+            prepared: prep,
+            z,
+            out,
+            psd,
+        };
+        finish(apply_raw::<T, D>(isa(), args), first_failed)
+    })
+}
