@@ -191,8 +191,8 @@ typedef struct {
    */
   uint32_t sweeps;
   /**
-   * Sweeps of `AMPM_METHOD_ONE_SIDED_JACOBI` (a fixed count, no stopping test; default 4
-   * in f32, 5 in f64), iteration cap of `AMPM_METHOD_QR` (QR sweeps, default 32) and of
+   * Sweeps of `AMPM_METHOD_ONE_SIDED_JACOBI` (a fixed count; default 3
+   * in f32, 4 in f64), iteration cap of `AMPM_METHOD_QR` (QR sweeps, default 32) and of
    * `AMPM_METHOD_HIGHAM_NOFERINI` (Jacobi sweeps per eigen-solve, default 16): 0 (default)
    * or 1..=1000. Reaching a cap without convergence is `AMPM_ERR_NOT_CONVERGED` (QR,
    * Higham–Noferini).

@@ -324,10 +324,20 @@ fn ffi_ex_matches_compile_time_methods() {
         let (a, c, p) = if o.method == AMPM_METHOD_DEFAULT {
             use ampm_core::kernel::batch::{ahat_chat_z, Outputs};
             let (mut a, mut c, mut p) = ([0.0; 9], [0.0; 9], [0.0; 1]);
-            let out = Outputs { ahat: Some(&mut a), chat_z: Some(&mut c), energy: Some(&mut p), psd: false };
-            let st = ahat_chat_z::<f64, 3>(ampm_core::lane::Isa::SCALAR, &[2.0], &F3, Some(&Z3), out);
+            let out = Outputs {
+                ahat: Some(&mut a),
+                chat_z: Some(&mut c),
+                energy: Some(&mut p),
+                psd: false,
+            };
+            let st =
+                ahat_chat_z::<f64, 3>(ampm_core::lane::Isa::SCALAR, &[2.0], &F3, Some(&Z3), out);
             assert_eq!(st.unwrap().error, None);
-            (Mat::from_col_major(&a).unwrap(), Mat::from_col_major(&c).unwrap(), p[0])
+            (
+                Mat::from_col_major(&a).unwrap(),
+                Mat::from_col_major(&c).unwrap(),
+                p[0],
+            )
         } else {
             (
                 augmented::ahat(&e, f).unwrap(),

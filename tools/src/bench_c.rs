@@ -125,8 +125,14 @@ pub fn read(path: &Path) -> Result<Option<BenchC>, String> {
         .ok()
         .and_then(|t| SystemTime::now().duration_since(t).ok())
         .map(|d| d.as_secs_f64() / 60.0);
+    // Shown relative to the workspace when inside it ("docs/bench-c.md").
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+    let shown = match (path.canonicalize(), root.canonicalize()) {
+        (Ok(p), Ok(r)) => p.strip_prefix(&r).map_or(p.clone(), Path::to_path_buf),
+        _ => path.to_path_buf(),
+    };
     Ok(Some(BenchC {
-        path: path.display().to_string(),
+        path: shown.display().to_string(),
         cpu,
         n,
         age_minutes,

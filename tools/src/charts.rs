@@ -153,11 +153,32 @@ fn err<E: std::fmt::Display>(e: E) -> String {
 /// A label box in pixels: `(left, top, right, bottom)`.
 type LabelBox = (i32, i32, i32, i32);
 
-/// Draws each label (anchor in backend pixels, text) at the first candidate offset whose box
-/// overlaps no label in `placed` (which it then joins).
+/// Offsets of a point's label (text box `w × h`) from the point, in order of preference.
+fn beside(w: i32, h: i32) -> Vec<(i32, i32)> {
+    vec![
+        (8, 2),
+        (8, -h - 2),
+        (8, h + 4),
+        (8, -2 * h - 4),
+        (8, 2 * h + 6),
+        (-w - 8, 2),
+        (-w - 8, -h - 2),
+        (-w - 8, h + 4),
+    ]
+}
+
+/// Offsets of a vertical line's label from the line's top end: right of the line, stepping
+/// down one text line at a time.
+fn below(_w: i32, h: i32) -> Vec<(i32, i32)> {
+    (0..8).map(|k| (4, 4 + k * (h + 2))).collect()
+}
+
+/// Draws each label (anchor in backend pixels, text) at the first offset of `offsets` whose
+/// box overlaps no label in `placed` (which it then joins).
 fn place_labels<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     labels: &[((i32, i32), String)],
+    offsets: fn(i32, i32) -> Vec<(i32, i32)>,
     placed: &mut Vec<LabelBox>,
 ) -> DrawResult
 where
@@ -169,16 +190,7 @@ where
         let (px, py) = (px - bx, py - by);
         let (w, h) = area.estimate_text_size(text, &font).map_err(err)?;
         let (w, h) = (w as i32, h as i32);
-        let candidates = [
-            (8, 2),
-            (8, -h - 2),
-            (8, h + 4),
-            (8, -2 * h - 4),
-            (8, 2 * h + 6),
-            (-w - 8, 2),
-            (-w - 8, -h - 2),
-            (-w - 8, h + 4),
-        ];
+        let candidates = offsets(w, h);
         let free = |x: i32, y: i32| {
             placed
                 .iter()
@@ -308,7 +320,7 @@ where
             )
         })
         .collect();
-    place_labels(root, &labels, &mut Vec::new())?;
+    place_labels(root, &labels, beside, &mut Vec::new())?;
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::LowerRight)
@@ -434,21 +446,24 @@ where
         }
     }
     // Labels: the lines' at the top of the plot, then the points' (next to the Â marker).
-    let mut labels: Vec<((i32, i32), String)> = panel
+    let mut placed = Vec::new();
+    let line_labels: Vec<((i32, i32), String)> = panel
         .lines
         .iter()
-        .map(|l| {
-            let (x, y) = chart.backend_coord(&(l.ns, yr.end));
-            ((x - 4, y + 4), l.label.clone())
+        .map(|l| (chart.backend_coord(&(l.ns, yr.end)), l.label.clone()))
+        .collect();
+    place_labels(root, &line_labels, below, &mut placed)?;
+    let labels: Vec<((i32, i32), String)> = panel
+        .points
+        .iter()
+        .map(|p| {
+            (
+                chart.backend_coord(&(p.ns, p.p99_ahat.max(ERROR_FLOOR))),
+                p.label.clone(),
+            )
         })
         .collect();
-    labels.extend(panel.points.iter().map(|p| {
-        (
-            chart.backend_coord(&(p.ns, p.p99_ahat.max(ERROR_FLOOR))),
-            p.label.clone(),
-        )
-    }));
-    place_labels(root, &labels, &mut Vec::new())?;
+    place_labels(root, &labels, beside, &mut placed)?;
     chart
         .configure_series_labels()
         .position(SeriesLabelPosition::LowerRight)

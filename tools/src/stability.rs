@@ -54,12 +54,12 @@ use crate::families::{generate, signed_perm, Case, Contract, Family, FamilyDim, 
 use crate::reference::{self, Dd, Dim, ReferenceDim};
 use ampm_core::augmented::Augmented;
 use ampm_core::energy::FixedCorotated;
-use ampm_core::polar::{
-    ClosedForm2, HighamNoferini, McAdams, OneSidedJacobi, QrSvd, Svd, SvdMethod,
-};
 use ampm_core::kernel::batch::{self as kbatch, BatchReal};
 use ampm_core::kernel::{Dim as KDim, LaneDim};
 use ampm_core::lane::{Isa, IsaKind};
+use ampm_core::polar::{
+    ClosedForm2, HighamNoferini, McAdams, OneSidedJacobi, QrSvd, Svd, SvdMethod,
+};
 use ampm_core::{Error, Mat, Matrix, Real};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -434,7 +434,13 @@ where
         let mut u = [T::ZERO; 9];
         let mut v = [T::ZERO; 9];
         let mut s = [T::ZERO; 3];
-        let st = kbatch::svd::<T, D>(self.0, &f.cols.concat(), &mut u[..D * D], &mut s[..D], &mut v[..D * D])?;
+        let st = kbatch::svd::<T, D>(
+            self.0,
+            &f.cols.concat(),
+            &mut u[..D * D],
+            &mut s[..D],
+            &mut v[..D * D],
+        )?;
         st.result().map_err(|e| e.1)?;
         let sigma: [T; D] = s[..D].try_into().expect("D values");
         Ok(Svd {
@@ -449,9 +455,18 @@ where
         let one = |what: u8| -> ampm_core::Result<Vec<T>> {
             let mut out = vec![T::ZERO; if what == 0 { 1 } else { D * D }];
             let o = match what {
-                0 => kbatch::Outputs { energy: Some(&mut out), ..Default::default() },
-                1 => kbatch::Outputs { ahat: Some(&mut out), ..Default::default() },
-                _ => kbatch::Outputs { chat_z: Some(&mut out), ..Default::default() },
+                0 => kbatch::Outputs {
+                    energy: Some(&mut out),
+                    ..Default::default()
+                },
+                1 => kbatch::Outputs {
+                    ahat: Some(&mut out),
+                    ..Default::default()
+                },
+                _ => kbatch::Outputs {
+                    chat_z: Some(&mut out),
+                    ..Default::default()
+                },
             };
             kbatch::ahat_chat_z::<T, D>(self.0, &mu, &fv, Some(&zv), o)?
                 .result()

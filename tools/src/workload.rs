@@ -277,9 +277,9 @@ pub const BATCH_SIGMA_MAX: f64 = 2.0;
 
 /// `n` particles in the distribution of `c_tests/bench_kernels` (not its draws: that program
 /// has its own generator), flattened for the batch calls: `(μ, F, Z)` with `μ = 1`,
-/// `F = R₁ diag(σ) R₂ᵀ`, σᵢ log-uniform in [[`BATCH_SIGMA_MIN`], [`BATCH_SIGMA_MAX`]], `R₁`, `R₂`
-/// Haar on `SO(d)`, `Z` entries uniform in `[−1, 1]`; drawn in `f64` from stream `stream` and
-/// rounded to `T`; `d²` column-major scalars per particle.
+/// `F = R₁ diag(σ) R₂ᵀ`, σᵢ log-uniform in [0.5, 2] ([`BATCH_SIGMA_MIN`],
+/// [`BATCH_SIGMA_MAX`]), `R₁`, `R₂` Haar on `SO(d)`, `Z` entries uniform in `[−1, 1]`; drawn in
+/// `f64` from stream `stream` and rounded to `T`; `d²` column-major scalars per particle.
 #[must_use]
 pub fn batch_workload<T: ampm_core::Real, const D: usize>(
     n: usize,

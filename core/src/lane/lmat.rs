@@ -378,7 +378,13 @@ pub fn jacobi_rotation<V: Lane>(alpha: V, beta: V, gamma: V) -> (V, V) {
         25..=53 => 3,
         _ => 5,
     };
-    let rs = |x: V| if V::LANES == 1 { x.rsqrt() } else { rsqrt_steps(x, steps) };
+    let rs = |x: V| {
+        if V::LANES == 1 {
+            x.rsqrt()
+        } else {
+            rsqrt_steps(x, steps)
+        }
+    };
     let r1 = rs(V::select(tiny, one, den2));
     let cc = (c::<V>(0.5) * d.abs()).mul_add(r1, c(0.5));
     let r2 = rs(cc);

@@ -10,14 +10,18 @@
 //!   `f32×16`/`f64×8` with AVX-512F. They are reachable only through the batch entry points
 //!   of [`crate::kernel`], which take an [`Isa`] that proves the CPU supports them.
 //!
-//! **Same bits on every path.** Every lane operation is an IEEE-754 operation that is
-//! correctly rounded on every path: `+ − × ÷`, `sqrt`, `floor`, and exact bit manipulations
-//! (`abs`, `copysign`, [`Lane::exponent`], [`Lane::pow2`], the integer seed
+//! **Bits.** The vector paths use only operations that round the same way on AVX2 and
+//! AVX-512: `+ − × ÷`, `sqrt`, `floor`, the fused [`Lane::mul_add`] (one rounding), and exact
+//! bit manipulations (`abs`, `copysign`, [`Lane::exponent`], [`Lane::pow2`], the integer seed
 //! [`Lane::rsqrt_guess`] of the Newton iterations in [`lmat`]). The hardware's approximate
-//! `rsqrt`/`rcp` instructions are not used: their bits differ between AVX2 and AVX-512. There is deliberately no fused
-//! multiply-add: on a scalar without an FMA instruction it is a ~6 ns software routine, and
-//! Rust never contracts `a·b + c` by itself. So a lane of a vector result has exactly the bits
-//! of the scalar result, on AVX2, AVX-512 and any other target (tested in `tests/batch.rs`).
+//! `rsqrt`/`rcp` instructions are not used: their bits differ between AVX2 and AVX-512. So
+//! the AVX2 and AVX-512 paths give identical bits, and a particle's result does not depend on
+//! its lane. The scalar instantiation differs on purpose: without an FMA instruction a fused
+//! multiply-add is a ~6 ns software routine, so it rounds `a·b + c` twice; its reciprocal
+//! square roots are `1/√x` (lower latency for one particle than a Newton chain); and it skips
+//! Jacobi rotations of pairs already orthogonal. It agrees with the vector paths to a few
+//! roundings amplified by the conditioning of `F` (bounds tested in `tests/batch.rs` and
+//! `c_tests/`).
 
 use crate::scalar::Real;
 use core::fmt::Debug;
