@@ -1,12 +1,12 @@
 // The 28 kernel symbols of include/ampm.h against the independent long-double reference of
-// common.hpp (issue 2, item 5), and that reference against central finite differences.
+// common.hpp, and that reference against central finite differences.
 //
 // For 2D and 3D, f32 and f64: random F = U diag(σ) Vᵀ with Haar U, V ∈ SO(d) and σᵢ
 // log-uniform in [0.2, 5] (so J > 0, κ₂(F) ≤ 25), random Gaussian Z, μ log-uniform in
 // [0.1, 10]. The reference is evaluated at the exact input the library saw (F, Z, μ rounded
 // to T and converted back to long double).
 //
-// Acceptance (issue 2): relative error ≤ 1e-11 in f64 and ≤ 1e-4 in f32, i.e. 4.5·10⁴ ε₆₄ and
+// Acceptance: relative error ≤ 1e-11 in f64 and ≤ 1e-4 in f32, i.e. 4.5·10⁴ ε₆₄ and
 // 8.4·10² ε₃₂. "Relative" is the Frobenius norm of the error over the Frobenius norm of the
 // reference result, except for Ψ̂ (see `psi_scale`).
 //
@@ -82,7 +82,7 @@ struct Worst {
 /// amplified by at most the conditioning the accuracy bound already allows for. So the bound is
 /// derived from that bound, not measured: the batch and the single call each meet
 /// ‖x − ref‖ ≤ K·ε·scale with K = Accept<T>::tol/ε (4.5·10⁴ in f64, 8.4·10² in f32, the
-/// acceptance of issue 2; both are checked above), hence ‖batch − single‖ ≤ 2K·ε·scale.
+/// acceptance; both are checked above), hence ‖batch − single‖ ≤ 2K·ε·scale.
 template <class T>
 constexpr ld kBatchVsSingle() {
   return 2 * Accept<T>::tol / static_cast<ld>(std::numeric_limits<T>::epsilon());

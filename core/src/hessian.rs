@@ -1,4 +1,4 @@
-//! Explicit Hessian matrices of Ψ̂ and the PSD-projected action Ĉ⁺:Z (issue 3, "Definiteness").
+//! Explicit Hessian matrices of Ψ̂ and the PSD-projected action Ĉ⁺:Z (its definiteness).
 //!
 //! For the fixed corotated base energy, `Ψ̂(F) = μ Σᵢ (σ̂ᵢ − 1)²` with `σ̂ᵢ = J^{−1/d} σᵢ` is an
 //! isotropic function of the singular values of `F`, so its Hessian `Ĉ` has an analytic

@@ -1,4 +1,4 @@
-//! C entry points of the Hessian matrices and the PSD-projected action (issue 3).
+//! C entry points of the Hessian matrices and the PSD-projected action.
 //!
 //! For every dimension × precision: `ampm_chat_z_psd_<d>_<p>` (Ĉ⁺:Z), its batch form, and
 //! the explicit d²×d² matrices `ampm_chat_matrix_<d>_<p>` (Ĉ) and

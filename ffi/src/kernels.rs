@@ -1,4 +1,4 @@
-//! The C entry points of the kernels of issue "core kernels": one thin wrapper per
+//! The C entry points of the kernels: one thin wrapper per
 //! op × dim × precision, each delegating to one generic body in `kernels_impl`.
 //!
 //! The wrappers are written out (not macro-generated) because cbindgen reads the source

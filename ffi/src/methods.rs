@@ -1,4 +1,4 @@
-//! C entry points taking a run-time polar/SVD method choice: the `_ex` variants (issue 3).
+//! C entry points taking a run-time polar/SVD method choice: the `_ex` variants.
 //!
 //! A method is chosen at run time by an [`AmpmOptions`] (NULL = defaults). Its `method` field
 //! is a plain `uint32_t` holding one of the `AMPM_METHOD_*` values, never a C enum read as a

@@ -1,4 +1,4 @@
-//! C entry points of the MPM particle updates (issue 4): stencils, P2G, G2P + particle update,
+//! C entry points of the MPM particle updates: stencils, P2G, G2P + particle update,
 //! the implicit force differential and the pressure, as batch calls over structure-of-arrays
 //! particle data, one wrapper per dim × precision around one generic body (module `imp`).
 //!

@@ -1,4 +1,4 @@
-//! Per-particle cost of each modelling level of the particle update (issue 4), 2D and 3D,
+//! Per-particle cost of each modelling level of the particle update, 2D and 3D,
 //! f32 and f64.
 //!
 //! `cargo bench -p ampm-tools --bench particle_levels`. Each sample runs P2G

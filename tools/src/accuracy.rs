@@ -1,4 +1,4 @@
-//! The accuracy side of issue 3, from the library's stability module
+//! The accuracy side of the speed–accuracy chart, from the library's stability module
 //! ([`ampm_tools::stability`], errors against the double-double reference): its table, its
 //! curves for the stability chart, and the p99 errors that pair with [`crate::methods`]'
 //! timings in the speed–accuracy chart.

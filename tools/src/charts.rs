@@ -1,4 +1,4 @@
-//! The charts of issue 3, drawn with plotters: the speed–accuracy chart (SVG and PNG) and the
+//! The charts of the report, drawn with plotters: the speed–accuracy chart (SVG and PNG) and the
 //! stability chart (SVG).
 //!
 //! Text: plotters' `ab_glyph` backend with a TrueType font read at run time and registered as

@@ -1,4 +1,4 @@
-//! Families of deformation gradients with stated contracts (issue 3).
+//! Families of deformation gradients with stated contracts.
 //!
 //! Every family is a deterministic (seeded) generator of `d×d` matrices, parameterised by the
 //! precision `T` it targets (its `ε`, its exponent range) and by a [`Size`]. The entries are

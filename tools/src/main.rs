@@ -163,7 +163,7 @@ fn run() -> Result<(), String> {
         "Random particles: `F = U diag(σ) Vᵀ`, σᵢ log-uniform in [{SIGMA_MIN}, {SIGMA_MAX}], \
          U, V Haar on SO(d); `Z` uniform entries, ‖Z‖_F = 1; μ = 1; seed {SEED:#x}.\n"
     );
-    let _ = writeln!(report, "## Kernels (issue 2)\n");
+    let _ = writeln!(report, "## Kernels\n");
     let _ = writeln!(
         report,
         "Norm-wise relative errors. f64 rows: against central finite differences with \
@@ -183,7 +183,7 @@ fn run() -> Result<(), String> {
         }
     );
     let _ = writeln!(report, "{kernels_md}\n");
-    let _ = writeln!(report, "## SVD methods (issue 3)\n");
+    let _ = writeln!(report, "## SVD methods\n");
     let _ = writeln!(report, "{}\n", accuracy::METHODS_NOTE);
     let _ = writeln!(report, "{methods_md}\n");
     let _ = writeln!(

@@ -1,4 +1,4 @@
-//! Double-double reference for R, Σ, Ψ̂, Â and Ĉ:Z (issue 3).
+//! Double-double reference for R, Σ, Ψ̂, Â and Ĉ:Z.
 //!
 //! [`Dd`] is a double-double scalar (`hi + lo`, unevaluated sum of two non-overlapping `f64`)
 //! whose arithmetic is the `twofloat` crate's (Joldes, Muller, Popescu 2017 algorithms, relative

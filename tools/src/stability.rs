@@ -1,4 +1,4 @@
-//! Error of each method × family × precision against the double-double reference (issue 3).
+//! Error of each method × family × precision against the double-double reference.
 //!
 //! For every matrix `F` of every [`Family`] (rounded to the precision `T` under test) the
 //! reference ([`crate::reference`]) is computed once in double-double; then every SVD method
