@@ -23,6 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod batch;
+mod chunk;
 pub mod prepared;
 
 use crate::error::Error;
