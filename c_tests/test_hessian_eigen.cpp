@@ -1,4 +1,4 @@
-// Issue 3 ("Definiteness") from C++/Eigen, through the C ABI only:
+// The definiteness of Ĉ (PSD projection, explicit matrices) from C++/Eigen, through the C ABI only:
 //   ampm_chat_matrix_<d>_<p>      explicit d²×d² Hessian Ĉ,
 //   ampm_chat_psd_matrix_<d>_<p>  its PSD projection Ĉ⁺,
 //   ampm_chat_z_psd_<d>_<p>       the action Ĉ⁺:Z, and ampm_chat_z_psd_batch_<d>_<p>,

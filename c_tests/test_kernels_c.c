@@ -64,6 +64,7 @@ static const char *status_name(AmpmStatus s) {
   case AMPM_ERR_NOT_CONVERGED: return "AMPM_ERR_NOT_CONVERGED";
   case AMPM_ERR_INTERNAL: return "AMPM_ERR_INTERNAL";
   case AMPM_ERR_NOT_PREPARED: return "AMPM_ERR_NOT_PREPARED";
+  case AMPM_ERR_OUTSIDE_GRID: return "AMPM_ERR_OUTSIDE_GRID";
   }
   return "(unknown status)";
 }

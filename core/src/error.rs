@@ -20,6 +20,9 @@ pub enum Error {
     /// A prepared-Hessian slot that no successful prepare wrote (zero-filled, or marked by a
     /// failed prepare): applying it would use stale or meaningless data.
     NotPrepared,
+    /// A particle's stencil reaches outside the node box of the grid view it transfers to or
+    /// from.
+    OutsideGrid,
 }
 
 /// Result type of the kernels.
@@ -33,6 +36,7 @@ impl core::fmt::Display for Error {
             Error::Overflow => "the result is not representable (overflow)",
             Error::InvalidArgument => "a parameter is outside its domain",
             Error::NotConverged => "iteration cap reached before convergence",
+            Error::OutsideGrid => "the particle's stencil reaches outside the grid view",
             Error::NotPrepared => {
                 "the prepared-Hessian slot was not written by a successful prepare"
             }

@@ -1,5 +1,6 @@
 //! Generic bodies of the C entry points: pointer checks, unaligned reads, all-or-nothing
-//! writes, panic containment. The `extern "C"` wrappers in the other modules only name types.
+//! writes, the batch contract, panic containment. The `extern "C"` wrappers (rendered into
+//! `generated/`) only name types.
 //!
 //! Memory contract (all entry points): matrices are `d·d` scalars, column-major
 //! (`F[i + d·j] = F_ij`), with no alignment requirement beyond the scalar's. Inputs are read
@@ -78,11 +79,38 @@ pub(crate) unsafe fn binary<M: Matrix>(
     unary::<M>(a, out, |x| k(x, &read_mat::<M>(b)))
 }
 
+/// Runs the body of a batch call with panics contained, and writes `*first_failed` (when
+/// non-null): the batch contract of the header.
+///
+/// `body` returns `Err(status)` for an error of the whole call, found before any record is
+/// read or written (a NULL required pointer, `n` too large, an invalid option): then
+/// `*first_failed` = 0. Otherwise it returns the call's status and the index of the first
+/// failed record (`n` if none), which goes to `*first_failed`. A caught panic (a bug) gives
+/// `AMPM_ERR_INTERNAL` and `*first_failed` = 0.
+///
+/// # Safety
+/// `first_failed` null or valid for writing one `usize`.
+#[inline]
+pub(crate) unsafe fn batch_call(
+    first_failed: *mut usize,
+    body: impl FnOnce() -> Result<(AmpmStatus, usize), AmpmStatus>,
+) -> AmpmStatus {
+    let (status, first) = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(body)) {
+        Ok(Ok(done)) => done,
+        Ok(Err(whole_call)) => (whole_call, 0),
+        Err(_) => (AmpmStatus::AMPM_ERR_INTERNAL, 0),
+    };
+    if !first_failed.is_null() {
+        *first_failed = first;
+    }
+    status
+}
+
 /// Batch driver: for each particle `i < n`, `k(i)` computes the result or an error; results
 /// are written to `out + i·M::LEN` only on success.
 ///
-/// `first_failed` (may be null) receives the index of the first failed particle, or `n`
-/// when all succeed. Returns the first failure's status, or `AMPM_OK`.
+/// Returns the first failure's status (or `AMPM_OK`) and its index (`n` when all succeed),
+/// for [`batch_call`].
 ///
 /// # Safety
 /// `out` must be valid for `n·M::LEN` scalars; `k` reads the inputs of particle `i` only.
@@ -90,9 +118,8 @@ pub(crate) unsafe fn binary<M: Matrix>(
 pub(crate) unsafe fn batch<M: Matrix>(
     n: usize,
     out: *mut M::Scalar,
-    first_failed: *mut usize,
     mut k: impl FnMut(usize) -> Result<M, Error>,
-) -> AmpmStatus {
+) -> (AmpmStatus, usize) {
     let mut status = AmpmStatus::AMPM_OK;
     let mut first = n;
     for i in 0..n {
@@ -106,26 +133,25 @@ pub(crate) unsafe fn batch<M: Matrix>(
             }
         }
     }
-    if !first_failed.is_null() {
-        *first_failed = first;
-    }
-    status
+    (status, first)
 }
 
-/// Checks the array pointers and size of a batch call: `AMPM_OK` to go on.
+/// Checks the array pointers and size of a batch call: `Err` is a whole-call error
+/// (`AMPM_ERR_NULL_POINTER`, then `AMPM_ERR_INVALID_ARGUMENT` for an `n` whose arrays are not
+/// addressable).
 ///
 /// Null arrays are accepted when `n == 0` (an empty `std::vector` has a null `data()`).
 #[inline]
-pub(crate) fn check_batch<M: Matrix>(n: usize, ptrs: &[bool]) -> AmpmStatus {
+pub(crate) fn check_batch<M: Matrix>(n: usize, ptrs: &[bool]) -> Result<(), AmpmStatus> {
     if n == 0 {
-        return AmpmStatus::AMPM_OK;
+        return Ok(());
     }
     if ptrs.iter().any(|&is_null| is_null) {
-        return AmpmStatus::AMPM_ERR_NULL_POINTER;
+        return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
     }
     // n·d² scalars must be addressable.
     match n.checked_mul(M::LEN * core::mem::size_of::<M::Scalar>()) {
-        Some(b) if b <= isize::MAX as usize => AmpmStatus::AMPM_OK,
-        _ => AmpmStatus::AMPM_ERR_INVALID_ARGUMENT,
+        Some(b) if b <= isize::MAX as usize => Ok(()),
+        _ => Err(AmpmStatus::AMPM_ERR_INVALID_ARGUMENT),
     }
 }

@@ -3,7 +3,7 @@
 //! the CPU (detected once, or chosen with `ampm_set_isa`), the single-particle calls on the
 //! scalar instantiation of the same source.
 
-use crate::abi::guard;
+use crate::abi::batch_call;
 use crate::status::AmpmStatus;
 use ampm_core::kernel::batch::{
     apply_raw, kernels_raw, prepare_raw, ApplyArgs, BatchReal, BatchStatus, KernelArgs, PrepareArgs,
@@ -62,19 +62,16 @@ fn size_ok<T>(n: usize, w: usize) -> bool {
         .is_some_and(|b| b <= isize::MAX as usize)
 }
 
-/// Writes `*first_failed` (when non-null) and turns the outcome into a status.
-///
-/// # Safety
-/// `first_failed` null or valid for writing.
-unsafe fn finish(st: BatchStatus, first_failed: *mut usize) -> AmpmStatus {
-    if !first_failed.is_null() {
-        *first_failed = st.first_failed;
-    }
-    st.error.map_or(AmpmStatus::AMPM_OK, Into::into)
+/// The outcome of the records of a batch, for [`batch_call`].
+fn finish(st: BatchStatus) -> Result<(AmpmStatus, usize), AmpmStatus> {
+    Ok((
+        st.error.map_or(AmpmStatus::AMPM_OK, Into::into),
+        st.first_failed,
+    ))
 }
 
 /// A batch of the kernels: `Â`, `Ĉ:Z`/`Ĉ⁺:Z`, `Ψ̂`, each output optional (null), at least one
-/// requested; `z` required with `chat_z`.
+/// requested; `z` required with `chat_z`. Follows the batch contract of [`batch_call`].
 ///
 /// # Safety
 /// Non-null pointers valid for `n` records.
@@ -94,14 +91,14 @@ pub(crate) unsafe fn kernels<T: BatchReal, const D: usize>(
 where
     Dim<D>: LaneDim<D>,
 {
-    guard(|| {
+    batch_call(first_failed, || {
         let no_output = ahat.is_null() && chat_z.is_null() && energy.is_null();
         if n > 0 && (no_output || mu.is_null() || f.is_null() || (!chat_z.is_null() && z.is_null()))
         {
-            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+            return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
         if !size_ok::<T>(n, D * D) {
-            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+            return Err(AmpmStatus::AMPM_ERR_INVALID_ARGUMENT);
         }
         let args = KernelArgs {
             n,
@@ -113,7 +110,7 @@ where
             energy,
             psd,
         };
-        finish(kernels_raw::<T, D>(isa, args), first_failed)
+        finish(kernels_raw::<T, D>(isa, args))
     })
 }
 
@@ -165,12 +162,12 @@ pub(crate) unsafe fn prepare<T: BatchReal, const D: usize>(
 where
     Dim<D>: LaneDim<D>,
 {
-    guard(|| {
+    batch_call(first_failed, || {
         if n > 0 && (mu.is_null() || f.is_null() || prep.is_null()) {
-            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+            return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
         if !size_ok::<T>(n, prepared::len(D)) {
-            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+            return Err(AmpmStatus::AMPM_ERR_INVALID_ARGUMENT);
         }
         let args = PrepareArgs {
             n,
@@ -179,7 +176,7 @@ where
             ahat,
             prepared: prep,
         };
-        finish(prepare_raw::<T, D>(isa(), args), first_failed)
+        finish(prepare_raw::<T, D>(isa(), args))
     })
 }
 
@@ -198,12 +195,12 @@ pub(crate) unsafe fn apply<T: BatchReal, const D: usize>(
 where
     Dim<D>: LaneDim<D>,
 {
-    guard(|| {
+    batch_call(first_failed, || {
         if n > 0 && (prep.is_null() || z.is_null() || out.is_null()) {
-            return AmpmStatus::AMPM_ERR_NULL_POINTER;
+            return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
         if !size_ok::<T>(n, prepared::len(D)) {
-            return AmpmStatus::AMPM_ERR_INVALID_ARGUMENT;
+            return Err(AmpmStatus::AMPM_ERR_INVALID_ARGUMENT);
         }
         let args = ApplyArgs {
             n,
@@ -212,6 +209,6 @@ where
             out,
             psd,
         };
-        finish(apply_raw::<T, D>(isa(), args), first_failed)
+        finish(apply_raw::<T, D>(isa(), args))
     })
 }

@@ -29,6 +29,9 @@ pub enum AmpmStatus {
     /// A prepared-Hessian slot that no successful `ampm_hessian_prepare_batch_*` wrote
     /// (zero-filled memory, or the slot of a particle whose prepare failed).
     AMPM_ERR_NOT_PREPARED = 8,
+    /// A particle's stencil reaches outside the node box of the grid view passed to a
+    /// transfer (P2G, G2P, force differential): nothing of that particle was transferred.
+    AMPM_ERR_OUTSIDE_GRID = 9,
 }
 
 impl From<Error> for AmpmStatus {
@@ -41,6 +44,7 @@ impl From<Error> for AmpmStatus {
             Error::InvalidArgument => AmpmStatus::AMPM_ERR_INVALID_ARGUMENT,
             Error::NotConverged => AmpmStatus::AMPM_ERR_NOT_CONVERGED,
             Error::NotPrepared => AmpmStatus::AMPM_ERR_NOT_PREPARED,
+            Error::OutsideGrid => AmpmStatus::AMPM_ERR_OUTSIDE_GRID,
         }
     }
 }

@@ -79,7 +79,8 @@ mod sealed {
 }
 
 /// A chunk loop, generic over the lane type.
-trait LaneOp<T> {
+pub(crate) trait LaneOp<T> {
+    /// Runs the loop on lanes `V`.
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus;
 }
 
@@ -97,7 +98,7 @@ unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
 
 /// Runs `op` on the lanes of `isa`.
 #[inline]
-fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> BatchStatus {
+pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> BatchStatus {
     match isa.kind() {
         IsaKind::Scalar => op.run::<T>(),
         #[cfg(target_arch = "x86_64")]

@@ -14,7 +14,7 @@ use core::ptr;
 /// # Safety
 /// `src` valid for reading `len` records.
 #[inline(always)]
-pub(super) unsafe fn gather<V: Lane, const WMAX: usize>(
+pub(crate) unsafe fn gather<V: Lane, const WMAX: usize>(
     src: *const V::Scalar,
     stride: usize,
     w: usize,
@@ -51,7 +51,7 @@ pub(super) unsafe fn gather<V: Lane, const WMAX: usize>(
 /// # Safety
 /// `dst` valid for writing `len` records.
 #[inline(always)]
-pub(super) unsafe fn scatter<V: Lane, const WMAX: usize>(
+pub(crate) unsafe fn scatter<V: Lane, const WMAX: usize>(
     src: &[V; WMAX],
     w: usize,
     dst: *mut V::Scalar,
@@ -85,7 +85,7 @@ pub(super) unsafe fn scatter<V: Lane, const WMAX: usize>(
 /// # Safety
 /// `src` valid for `len` matrices.
 #[inline(always)]
-pub(super) unsafe fn load_mats<V: Lane, const D: usize>(
+pub(crate) unsafe fn load_mats<V: Lane, const D: usize>(
     src: *const V::Scalar,
     len: usize,
     pad_identity: bool,
@@ -121,7 +121,7 @@ pub(super) unsafe fn load_mats<V: Lane, const D: usize>(
 /// # Safety
 /// `dst` valid for `len` matrices.
 #[inline(always)]
-pub(super) unsafe fn store_mats<V: Lane, const D: usize>(
+pub(crate) unsafe fn store_mats<V: Lane, const D: usize>(
     m: &LMat<V, D>,
     dst: *mut V::Scalar,
     len: usize,
@@ -138,7 +138,7 @@ pub(super) unsafe fn store_mats<V: Lane, const D: usize>(
 
 /// The first failure of a chunk, if any, as `(lane, status)`.
 #[inline(always)]
-pub(super) fn first_error(bits: &[(u32, Error)], len: usize) -> Option<(usize, Error)> {
+pub(crate) fn first_error(bits: &[(u32, Error)], len: usize) -> Option<(usize, Error)> {
     let all = bits.iter().fold(0u32, |a, (b, _)| a | b);
     let all = all & (u32::MAX >> (32 - len as u32));
     if all == 0 {
@@ -150,7 +150,7 @@ pub(super) fn first_error(bits: &[(u32, Error)], len: usize) -> Option<(usize, E
 
 /// Tracks the first failure over the chunks of a batch.
 #[derive(Clone, Copy)]
-pub(super) struct First {
+pub(crate) struct First {
     n: usize,
     at: usize,
     err: Option<Error>,
@@ -158,7 +158,7 @@ pub(super) struct First {
 
 impl First {
     #[inline(always)]
-    pub(super) fn new(n: usize) -> Self {
+    pub(crate) fn new(n: usize) -> Self {
         Self {
             n,
             at: n,
@@ -166,7 +166,7 @@ impl First {
         }
     }
     #[inline(always)]
-    pub(super) fn note(&mut self, start: usize, bits: &[(u32, Error)], len: usize) {
+    pub(crate) fn note(&mut self, start: usize, bits: &[(u32, Error)], len: usize) {
         if self.err.is_none() {
             if let Some((l, e)) = first_error(bits, len) {
                 self.at = start + l;
@@ -175,7 +175,7 @@ impl First {
         }
     }
     #[inline(always)]
-    pub(super) fn status(self) -> super::batch::BatchStatus {
+    pub(crate) fn status(self) -> super::batch::BatchStatus {
         super::batch::BatchStatus {
             first_failed: if self.err.is_some() { self.at } else { self.n },
             error: self.err,
@@ -185,13 +185,13 @@ impl First {
 
 /// An all-false mask.
 #[inline(always)]
-pub(super) fn none<V: Lane>() -> V::Mask {
+pub(crate) fn none<V: Lane>() -> V::Mask {
     V::splat(<V::Scalar as Real>::ONE).lt(V::splat(<V::Scalar as Real>::ZERO))
 }
 
 /// The check masks of [`evaluate`] as bit sets with their statuses, in order of precedence.
 #[inline(always)]
-pub(super) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u32, Error); 5] {
+pub(crate) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u32, Error); 5] {
     [
         (V::mask_bits(ck.f_non_finite), Error::NonFinite),
         (V::mask_bits(ck.j_non_positive), Error::NonPositiveJ),

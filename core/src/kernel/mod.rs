@@ -23,7 +23,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod batch;
-mod chunk;
+pub(crate) mod chunk;
 pub mod prepared;
 
 use crate::error::Error;
@@ -111,6 +111,10 @@ pub struct Coeffs<V, const D: usize> {
     pub sym: [V; 3],
     /// `λ_skew` of each pair of [`PAIRS`].
     pub skew: [V; 3],
+    /// The singular values `x = sσ` of `F̂ = Jᵃ F` (1 on liquid and failed lanes).
+    pub x: [V; D],
+    /// `s = det(G)^{−1/d}`: `x/s` are the singular values of `G = 2⁻ᵏF`.
+    pub s: V,
 }
 
 /// Lane masks of the input checks, in the order of precedence of their statuses.
@@ -308,6 +312,8 @@ pub fn coefficients<V: Lane, const D: usize>(
         block,
         sym,
         skew,
+        x: *x,
+        s,
     }
 }
 

@@ -85,6 +85,8 @@ pub fn unpack<V: Lane, const D: usize>(s: &[V], psd: bool) -> (Coeffs<V, D>, V::
         block: [[zero; D]; D],
         sym: [zero; 3],
         skew: [zero; 3],
+        x: [zero; D],
+        s: zero,
     };
     let mut o = 2;
     for m in [&mut co.u, &mut co.v] {

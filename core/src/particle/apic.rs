@@ -39,17 +39,60 @@ pub struct GatheredScalar<T, const D: usize> {
     pub grad: [T; D],
 }
 
-/// `1/(κ h²)`, the inverse APIC moment `D_p⁻¹` as a scalar.
+/// `1/(κ h²)` (1/m²), the inverse APIC moment `D_p⁻¹` as a scalar, formed as
+/// `(1/(κ h))/h` so that `h²` never under- or overflows on its own.
+///
+/// Errors: [`Error::NonFinite`] for a NaN/inf `h`, [`Error::InvalidArgument`] for `h ≤ 0`,
+/// [`Error::Overflow`] when the result is not representable (inf for a tiny `h`, 0 for a
+/// huge one).
 #[inline]
-#[must_use]
-pub fn inv_moment<T: Real>(kernel: Kernel, h: T) -> T {
-    T::ONE / (kernel.apic_moment::<T>() * h * h)
+pub fn inv_moment<T: Real>(kernel: Kernel, h: T) -> Result<T> {
+    let inv_kh = inv_kappa_h(kernel, h)?;
+    let m = inv_kh / h;
+    if m.is_finite() && m > T::ZERO {
+        Ok(m)
+    } else {
+        Err(Error::Overflow)
+    }
+}
+
+/// `1/(κ h)` (1/m): the gathers form `C_p = (Σ_i w_i q_i ((x_i − x_p)/h)ᵀ) / (κ h)` with the
+/// offsets in cells, `(x_i − x_p)/h = o − fx` (see [`super::stencil`]), so no `h²` appears.
+///
+/// Errors: as [`inv_moment`] (a positive finite `h` has `1/(κ h) > 0`, so only inf
+/// overflows).
+#[inline]
+fn inv_kappa_h<T: Real>(kernel: Kernel, h: T) -> Result<T> {
+    if !h.is_finite() {
+        return Err(Error::NonFinite);
+    }
+    if h <= T::ZERO {
+        return Err(Error::InvalidArgument);
+    }
+    let inv_kh = T::ONE / (kernel.apic_moment::<T>() * h);
+    if inv_kh.is_finite() {
+        Ok(inv_kh)
+    } else {
+        Err(Error::Overflow)
+    }
+}
+
+/// `(x_i − x_p)/h = o − fx` of node `r`, in cells (`|·| ≤ 2`).
+#[inline]
+fn cell_offsets<T: Real, const D: usize>(s: &Stencil<T, D>, r: usize) -> [T; D] {
+    let o = s.offsets(r);
+    let mut e = [T::ZERO; D];
+    for a in 0..D {
+        e[a] = T::from_i32(o[a] as i32) - s.fx[a];
+    }
+    e
 }
 
 /// G2P from a collocated grid: node velocities `vel[r]` (m/s) in stencil order.
 ///
 /// Errors: [`Error::InvalidArgument`] when `vel` is shorter than the stencil;
-/// [`Error::NonFinite`] when a result is not finite.
+/// [`Error::NonFinite`] for a NaN/inf node velocity; [`Error::Overflow`] when a result of
+/// finite inputs is not representable (also `1/(κ h)` for a tiny finite `h`).
 #[inline]
 pub fn gather<T: Real, const D: usize>(
     s: &Stencil<T, D>,
@@ -58,30 +101,37 @@ pub fn gather<T: Real, const D: usize>(
     if vel.len() < s.len() {
         return Err(Error::InvalidArgument);
     }
+    let inv_kh = inv_kappa_h(s.kernel, s.h)?;
     let mut v = [T::ZERO; D];
     let mut b = Mat::<T, D>::ZERO;
     let mut g = Mat::<T, D>::ZERO;
+    let mut inputs_finite = true;
     for (r, vi) in vel.iter().enumerate().take(s.len()) {
         let n = s.node(r);
+        let e = cell_offsets(s, r);
         for j in 0..D {
             for i in 0..D {
-                b.cols[j][i] += n.weight * vi[i] * n.dx[j];
+                b.cols[j][i] += n.weight * vi[i] * e[j];
                 g.cols[j][i] += vi[i] * n.grad[j];
             }
         }
         for i in 0..D {
+            inputs_finite &= vi[i].is_finite();
             v[i] += n.weight * vi[i];
         }
     }
+    if !inputs_finite {
+        return Err(Error::NonFinite);
+    }
     let out = Gathered {
         v,
-        affine: b * inv_moment(s.kernel, s.h),
+        affine: b * inv_kh,
         grad_v: g,
     };
     if v.iter().all(|x| x.is_finite()) && out.affine.is_finite() && g.is_finite() {
         Ok(out)
     } else {
-        Err(Error::NonFinite)
+        Err(Error::Overflow)
     }
 }
 
@@ -97,20 +147,26 @@ pub fn gather_scalar<T: Real, const D: usize>(
     if q.len() < s.len() {
         return Err(Error::InvalidArgument);
     }
+    let inv_kh = inv_kappa_h(s.kernel, s.h)?;
     let mut value = T::ZERO;
     let mut affine = [T::ZERO; D];
     let mut grad = [T::ZERO; D];
+    let mut inputs_finite = true;
     for (r, &qi) in q.iter().enumerate().take(s.len()) {
         let n = s.node(r);
+        let e = cell_offsets(s, r);
+        inputs_finite &= qi.is_finite();
         value += n.weight * qi;
         for a in 0..D {
-            affine[a] += n.weight * qi * n.dx[a];
+            affine[a] += n.weight * qi * e[a];
             grad[a] += qi * n.grad[a];
         }
     }
-    let inv = inv_moment(s.kernel, s.h);
+    if !inputs_finite {
+        return Err(Error::NonFinite);
+    }
     for x in affine.iter_mut() {
-        *x *= inv;
+        *x *= inv_kh;
     }
     let ok = value.is_finite()
         && affine.iter().all(|x| x.is_finite())
@@ -122,7 +178,7 @@ pub fn gather_scalar<T: Real, const D: usize>(
             grad,
         })
     } else {
-        Err(Error::NonFinite)
+        Err(Error::Overflow)
     }
 }
 

@@ -10,6 +10,8 @@
 //! - [`dilation`]: `Ψ_λ(J_E) = λ/2 (J_E − 1)²`, pressure and the pressure-solve coefficient,
 //!   with `1/λ` stored so the incompressible limit is representable.
 //! - [`thermal`]: temperature from the grid (PIC/FLIP), latent heat buffer, phase switch.
+//! - [`transfer`]: batch P2G, G2P and the implicit force differential through views of the
+//!   host's own grid (no per-node buffers); [`implicit`]: the prepared force differential.
 //! - [`update`]: the per-particle entries — [`update::p2g`] (stencil, mass, momentum, stress
 //!   force, heat), [`update::g2p_update`] (velocity, affine matrix, position, `F_E`,
 //!   plasticity, temperature, phase), [`update::Stiffness`] (the force differential of an
@@ -31,8 +33,11 @@
 pub mod apic;
 pub mod deformation;
 pub mod dilation;
+pub mod implicit;
 pub mod stencil;
+pub mod stiffness;
 pub mod thermal;
+pub mod transfer;
 pub mod update;
 
 pub use stencil::{Grid, Kernel, Node, Stencil};
@@ -49,7 +54,7 @@ pub enum Phase {
     /// Solid: fixed corotated elasticity, optionally snow plasticity.
     #[default]
     Solid = 0,
-    /// Liquid: `μ = 0`, `F_E` kept isotropic (`J_E^{1/d} I`).
+    /// Liquid: `μ = 0`, `F_E` and `F_P` kept isotropic (`J_E^{1/d} I`, `J_P^{1/d} I`).
     Liquid = 1,
 }
 
@@ -121,10 +126,11 @@ pub enum Definiteness {
     /// The exact `Ĉ` (indefinite away from conformal `F`, Smith et al. 2019).
     #[default]
     Exact,
-    /// The PSD projection `Ĉ⁺` ([`crate::hessian`]), for a definite Krylov solve (CG). Only
-    /// `Ĉ` is projected: with [`Dilation::Explicit`] the dilational term is added unprojected
-    /// (it is indefinite wherever `Ψ_λ' ≠ 0`), so a definite operator also needs
-    /// [`Dilation::PressureSolve`].
+    /// A definite operator for a Krylov solve (CG). The batch force differential
+    /// ([`transfer::force`], the C ABI) projects the whole differential, dilational part
+    /// included, block by block in the rotated basis of `F_E` ([`implicit`]). The
+    /// per-particle [`update::Stiffness`] projects only `Ĉ` (`Ĉ⁺`, [`crate::hessian`]) and adds
+    /// the dilational term unprojected (indefinite wherever `Ψ_λ' ≠ 0`).
     Projected,
 }
 
@@ -251,7 +257,8 @@ impl<T: Real> Material<T> {
     /// plasticity a solid hardens, `μ = μ₀ e^{ξ(1 − J_P)}`, `1/λ = (1/λ₀) e^{−ξ(1 − J_P)}`
     /// (Stomakhin et al. 2013, eq. 2); otherwise the phase's `μ₀`, `1/λ₀`.
     ///
-    /// Errors: [`Error::Overflow`] when the hardening factor is not representable.
+    /// Errors: [`Error::Overflow`] when the hardening factor, `μ` or `1/λ` is not
+    /// representable.
     #[inline]
     pub fn moduli(&self, phase: Phase, j_p: T) -> Result<Moduli<T>> {
         let p = self.params(phase);
@@ -260,7 +267,7 @@ impl<T: Real> Material<T> {
                 let e = (s.hardening * (T::ONE - j_p)).exp();
                 let mu = p.mu * e;
                 let inv_lambda = p.inv_lambda / e;
-                if !(e.is_finite() && mu.is_finite()) || e == T::ZERO {
+                if !(e.is_finite() && mu.is_finite() && inv_lambda.is_finite()) || e == T::ZERO {
                     return Err(Error::Overflow);
                 }
                 Ok(Moduli { mu, inv_lambda })

@@ -7,6 +7,10 @@
 //! - [`Grid::Face`]`(a)`: the grid of the `a`-th velocity component of a MAC grid, nodes at
 //!   `i h` along axis `a` and at cell centres `(j + ½) h` along every other axis.
 //!
+//! The position limit is `|x/h| < 2³⁰` per axis (cell indices well inside `i32`): beyond it
+//! a stencil is refused with [`Error::InvalidArgument`]. A finite `h > 0` so small that
+//! `1/h` is not representable is [`Error::Overflow`].
+//!
 //! **Node indexing.** A stencil covers `K^d` nodes, `K = 3` (quadratic) or `4` (cubic): the
 //! grid nodes `base + o`, `o ∈ {0, …, K−1}^d`. Node `r ∈ [0, K^d)` has offsets
 //! `o_a = (r / K^a) mod K` (axis 0 fastest), so `r = Σ_a o_a K^a`. Every per-node array of the
@@ -152,7 +156,8 @@ pub struct Stencil<T, const D: usize> {
     pub dw: [[T; 4]; D],
 }
 
-/// Positions whose cell index does not fit comfortably in `i32` are refused.
+/// The position limit: positions with `|x/h| ≥ 2³⁰` (cell indices that do not fit
+/// comfortably in `i32`) are refused.
 const MAX_CELLS: f64 = 1_073_741_824.0; // 2^30
 
 impl<T: Real, const D: usize> Stencil<T, D> {
@@ -160,20 +165,12 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     /// spacing `h` (m).
     ///
     /// Errors: [`Error::NonFinite`] for a NaN/inf position or spacing;
-    /// [`Error::InvalidArgument`] for `h ≤ 0`, a face axis `≥ d`, or `|x/h| ≥ 2³⁰`.
+    /// [`Error::InvalidArgument`] for `h ≤ 0`, a face axis `≥ d`, or a position beyond the
+    /// position limit `|x/h| < 2³⁰` (also when `x/h` overflows); [`Error::Overflow`] for a
+    /// finite `h > 0` so small that `1/h` is not representable.
     #[inline]
     pub fn new(kernel: Kernel, grid: Grid, h: T, x: &[T; D]) -> Result<Self> {
-        if !h.is_finite() || x.iter().any(|c| !c.is_finite()) {
-            return Err(Error::NonFinite);
-        }
-        if h <= T::ZERO {
-            return Err(Error::InvalidArgument);
-        }
-        if let Grid::Face(a) = grid {
-            if a >= D {
-                return Err(Error::InvalidArgument);
-            }
-        }
+        let inv_h = Self::inv_spacing(grid, h, x)?;
         let mut s = Self {
             kernel,
             h,
@@ -182,17 +179,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             w: [[T::ZERO; 4]; D],
             dw: [[T::ZERO; 4]; D],
         };
-        let inv_h = T::ONE / h;
         for a in 0..D {
-            let shift = match grid {
-                Grid::Face(f) if f != a => T::HALF,
-                _ => T::ZERO,
-            };
-            let xi = x[a] * inv_h - shift;
-            let xi64 = xi.to_f64();
-            if !xi.is_finite() || xi64.abs() >= MAX_CELLS {
-                return Err(Error::InvalidArgument);
-            }
+            let (xi, xi64) = cell_coordinate(grid, a, inv_h, x[a])?;
             let fl = libm::floor(xi64);
             // Exact: ξ − ⌊ξ⌋ (Sterbenz for |ξ| ≥ 1, trivially below), in [0, 1).
             let frac = xi - T::from_f64(fl);
@@ -210,10 +198,46 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             for o in 0..kernel.width() {
                 let (n, dn) = kernel.n_dn(fx - T::from_i32(o as i32));
                 s.w[a][o] = n;
+                // |N'| ≤ 1 for both kernels, so this is at most 1/h: finite.
                 s.dw[a][o] = dn * inv_h;
             }
         }
         Ok(s)
+    }
+
+    /// Checks what [`Stencil::new`] checks about `h` and `x` without building the stencil:
+    /// `Ok` exactly when `Stencil::new(_, grid, h, x)` is.
+    ///
+    /// Errors: as [`Stencil::new`].
+    #[inline]
+    pub fn check_position(grid: Grid, h: T, x: &[T; D]) -> Result<()> {
+        let inv_h = Self::inv_spacing(grid, h, x)?;
+        for a in 0..D {
+            cell_coordinate(grid, a, inv_h, x[a])?;
+        }
+        Ok(())
+    }
+
+    /// Validates `grid`, `h` and the finiteness of `x`; returns `1/h`.
+    #[inline]
+    fn inv_spacing(grid: Grid, h: T, x: &[T; D]) -> Result<T> {
+        if !h.is_finite() || x.iter().any(|c| !c.is_finite()) {
+            return Err(Error::NonFinite);
+        }
+        if h <= T::ZERO {
+            return Err(Error::InvalidArgument);
+        }
+        if let Grid::Face(a) = grid {
+            if a >= D {
+                return Err(Error::InvalidArgument);
+            }
+        }
+        let inv_h = T::ONE / h;
+        if !inv_h.is_finite() {
+            // A finite h > 0 whose inverse is not representable.
+            return Err(Error::Overflow);
+        }
+        Ok(inv_h)
     }
 
     /// Number of nodes, `K^d`.
@@ -277,8 +301,26 @@ impl<T: Real, const D: usize> Stencil<T, D> {
 
     /// Iterator over the nodes in stencil order.
     #[inline]
-    #[must_use]
     pub fn nodes(&self) -> impl Iterator<Item = Node<T, D>> + '_ {
         (0..self.len()).map(move |r| self.node(r))
     }
+}
+
+/// The cell coordinate `ξ = x/h − shift` of axis `a` (`shift = ½` on the cell-centred axes of
+/// a face grid), in `T` and in `f64`.
+///
+/// Errors: [`Error::InvalidArgument`] beyond the position limit `|ξ| < 2³⁰` (also when `x/h`
+/// overflows).
+#[inline]
+fn cell_coordinate<T: Real>(grid: Grid, a: usize, inv_h: T, x: T) -> Result<(T, f64)> {
+    let shift = match grid {
+        Grid::Face(f) if f != a => T::HALF,
+        _ => T::ZERO,
+    };
+    let xi = x * inv_h - shift;
+    let xi64 = xi.to_f64();
+    if !xi.is_finite() || xi64.abs() >= MAX_CELLS {
+        return Err(Error::InvalidArgument);
+    }
+    Ok((xi, xi64))
 }

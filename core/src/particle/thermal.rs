@@ -18,6 +18,7 @@
 //! (`0 < U < L`) only at `T = T_m`, and `U = L` for a liquid above `T_m`, `U = 0` for a solid
 //! below it. So liquid water at 300 K has `U = L`, ice at 250 K has `U = 0`.
 
+use super::stencil::Stencil;
 use super::{Heat, Phase};
 use crate::error::{Error, Result};
 use crate::scalar::Real;
@@ -43,6 +44,40 @@ pub struct HeatSplit<T> {
     pub latent: T,
     /// `c_l ΔT` spent warming or cooling the liquid (J/kg).
     pub liquid: T,
+}
+
+/// The G2P sums of the temperature transfer from node temperatures `(T_iⁿ⁺¹, T_iⁿ)` (K) in
+/// stencil order: `(Σ w_i T_iⁿ⁺¹, Σ w_i (T_iⁿ⁺¹ − T_iⁿ))`, the `t_pic` and `t_flip` of
+/// [`super::update::G2pSample`].
+///
+/// Errors: [`Error::InvalidArgument`] for slices shorter than the stencil;
+/// [`Error::NonFinite`] for a NaN/inf node temperature; [`Error::Overflow`] when a sum of
+/// finite temperatures is not representable.
+#[inline]
+pub fn gather<T: Real, const D: usize>(
+    s: &Stencil<T, D>,
+    t_new: &[T],
+    t_old: &[T],
+) -> Result<(T, T)> {
+    let n = s.len();
+    if t_new.len() < n || t_old.len() < n {
+        return Err(Error::InvalidArgument);
+    }
+    let (mut pic, mut flip) = (T::ZERO, T::ZERO);
+    let mut inputs_finite = true;
+    for r in 0..n {
+        let w = s.node(r).weight;
+        inputs_finite &= t_new[r].is_finite() && t_old[r].is_finite();
+        pic += w * t_new[r];
+        flip += w * (t_new[r] - t_old[r]);
+    }
+    if !inputs_finite {
+        Err(Error::NonFinite)
+    } else if pic.is_finite() && flip.is_finite() {
+        Ok((pic, flip))
+    } else {
+        Err(Error::Overflow)
+    }
 }
 
 /// The PIC/FLIP blend `T* = (1 − α) T_pic + α (T_p + ΔT_flip)` (K).
@@ -110,7 +145,9 @@ pub fn absorb<T: Real>(
             (Phase::Solid, true) if s.temperature < tm => {
                 let room = c_solid * (tm - s.temperature);
                 if q < room {
-                    s.temperature += q / c_solid;
+                    // q < c (T_m − T), but q/c may round to one ulp above T_m − T: clamp, so
+                    // that a solid stays at or below T_m.
+                    s.temperature = (s.temperature + q / c_solid).min(tm);
                     split.solid += q;
                     q = T::ZERO;
                 } else {
@@ -143,7 +180,8 @@ pub fn absorb<T: Real>(
             (Phase::Liquid, false) if s.temperature > tm => {
                 let room = c_liquid * (s.temperature - tm);
                 if -q < room {
-                    s.temperature += q / c_liquid;
+                    // As above: a liquid stays at or above T_m.
+                    s.temperature = (s.temperature + q / c_liquid).max(tm);
                     split.liquid += q;
                     q = T::ZERO;
                 } else {

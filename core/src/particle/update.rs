@@ -8,31 +8,46 @@
 //! 2. The host's grid work: velocities, boundary conditions, an implicit solve applying
 //!    [`Stiffness`] per Krylov iteration, a pressure solve with
 //!    [`pressure_coefficient`], a heat solve.
-//! 3. [`g2p_update`] per particle: temperature and phase, velocity and affine matrix, position,
-//!    `F_E` (with the remedy for `det(I + Δt∇v) ≤ 0`), then the liquid projection or the snow
-//!    plasticity.
+//! 3. [`g2p_update`] per particle: the gather ([`apic::gather`], [`thermal::gather`]) into a
+//!    [`G2pSample`], then [`update_particle`]: temperature and phase, velocity and affine
+//!    matrix, position, `F_E` (with the remedy for `det(I + Δt∇v) ≤ 0`), then the liquid
+//!    projection or the snow plasticity. A host that gathers itself (a MAC grid, its own
+//!    grid layout) calls [`update_particle`] directly.
 //!
 //! Every entry validates its inputs and returns a new value (or fills caller-provided
 //! per-node slices only on success), so a failed particle is left as it was.
+//!
+//! **Statuses.** A NaN/inf input is [`Error::NonFinite`]; a result of finite inputs that is
+//! not representable is [`Error::Overflow`] (also a determinant that underflows); an `F_E`
+//! or `F_P` singular to working precision is [`Error::NonPositiveJ`]. What an entry returns
+//! with `Ok` is finite; the particle that [`update_particle`] and [`g2p_update`] return is
+//! accepted by every entry ([`check_particle`], [`thermal::check_state`],
+//! [`Material::moduli`]), so a step that succeeds never leaves a particle that the next
+//! step refuses.
 
 use super::apic::{self, gather};
-use super::deformation::{evolve, liquid_projection, snow_plasticity};
+use super::deformation::{check_det, evolve, liquid_projection, snow_plasticity};
 use super::dilation;
 use super::stencil::{Grid, Kernel, Stencil};
 use super::thermal::{self, HeatSplit, ThermalState};
-use super::{Definiteness, Dilation, Material, Particle, Phase};
+use super::{Dilation, Material, Particle, Phase};
 use crate::augmented::Augmented;
 use crate::energy::FixedCorotated;
 use crate::error::{Error, Result};
-use crate::hessian::{HessianDim, HessianEigensystem};
 use crate::mat::{Mat, Matrix};
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
 
+pub use super::stiffness::{elastic_energy, force_differential, Stiffness};
+
 /// Checks the fields every entry reads: finite state, positive mass and volume, `J_E`,
-/// `J_P > 0`. Returns `(J_E, J_P)`.
+/// `J_P > 0` (computed determinants, finite). Returns `(J_E, J_P)`.
+///
+/// Errors: [`Error::NonFinite`] for a NaN/inf field, [`Error::InvalidArgument`] for
+/// `m ≤ 0` or `V⁰ ≤ 0`, [`Error::Overflow`] for a determinant that overflows,
+/// [`Error::NonPositiveJ`] for `J_E ≤ 0` or `J_P ≤ 0`.
 #[inline]
-fn check_particle<T: Real, const D: usize>(p: &Particle<T, D>) -> Result<(T, T)>
+pub fn check_particle<T: Real, const D: usize>(p: &Particle<T, D>) -> Result<(T, T)>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
@@ -81,8 +96,12 @@ where
     kirchhoff_unchecked(material, p, j_e, j_p)
 }
 
+/// [`kirchhoff_stress`] of a particle already checked by [`check_particle`] (which returned
+/// `(j_e, j_p)`) with a material already validated for its phase.
+///
+/// Errors: the kernels' errors; [`Error::Overflow`] for a stress that is not representable.
 #[inline]
-fn kirchhoff_unchecked<T: Real, const D: usize>(
+pub fn kirchhoff_unchecked<T: Real, const D: usize>(
     material: &Material<T>,
     p: &Particle<T, D>,
     j_e: T,
@@ -157,7 +176,8 @@ impl<T: Real, const D: usize> P2g<T, D>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
-    /// The contribution to stencil node `r < stencil.len()`.
+    /// The contribution to stencil node `r < stencil.len()`. Finite for every `r` when this
+    /// came from [`p2g`]; [`P2g::node_checked`] checks.
     #[inline]
     #[must_use]
     pub fn node(&self, r: usize) -> NodeP2g<T, D> {
@@ -173,12 +193,68 @@ where
             conductivity: n.weight * self.conductivity,
         }
     }
+
+    /// [`P2g::node`], checked.
+    ///
+    /// Errors: [`Error::InvalidArgument`] for `r ≥ stencil.len()`; [`Error::Overflow`] when
+    /// a value of the contribution is not finite.
+    #[inline]
+    pub fn node_checked(&self, r: usize) -> Result<NodeP2g<T, D>> {
+        if r >= self.stencil.len() {
+            return Err(Error::InvalidArgument);
+        }
+        let n = self.node(r);
+        let mut chk = n.weight * T::ZERO
+            + n.mass * T::ZERO
+            + n.heat_capacity * T::ZERO
+            + n.thermal_energy * T::ZERO
+            + n.conductivity * T::ZERO;
+        for a in 0..D {
+            chk += n.momentum[a] * T::ZERO + n.force[a] * T::ZERO;
+        }
+        // x·0 is 0 for finite x and NaN for NaN/inf.
+        if chk == T::ZERO {
+            Ok(n)
+        } else {
+            Err(Error::Overflow)
+        }
+    }
+
+    /// Whether every node contribution is finite.
+    ///
+    /// First a bound: rounding is monotone and `|fl(a + b)| ≤ fl(|a| + |b|)`, so a value
+    /// computed with the same operations from upper bounds of the factors' magnitudes bounds
+    /// the computed node value. With `w_i ≤ 1`, `|x_i − x_p| ≤ 2h` (computed as `(o − fx) h`,
+    /// `|o − fx| ≤ 2`) and `|∇w_i|_a ≤ 1/h` (`|N'| ≤ 1`, the other factors `≤ 1`), every
+    /// node value is at most one of `m_p (|v_a| + Σ_b |C_ab| 2h)`, `Σ_b |f_ab| / h`, `m_p`,
+    /// `m_p c_p`, `m_p c_p |T_p|`, `m_p κ_p`; when these are finite, so is every node. Only
+    /// when one is not (within a small factor of the overflow threshold) are the nodes
+    /// checked one by one, so the answer is exact.
+    #[inline]
+    fn nodes_finite(&self) -> bool {
+        let h = self.stencil.h;
+        let dx = [h + h; D];
+        let g = [T::ONE / h; D];
+        let c = self.affine.map(|x| x.abs()).mul_vec(dx);
+        let f = self.force.map(|x| x.abs()).mul_vec(g);
+        let mut chk = self.mass * T::ZERO
+            + self.heat_capacity * T::ZERO
+            + (self.heat_capacity * self.temperature.abs()) * T::ZERO
+            + self.conductivity * T::ZERO;
+        for a in 0..D {
+            chk += (self.mass * (self.v[a].abs() + c[a])) * T::ZERO + f[a] * T::ZERO;
+        }
+        chk == T::ZERO || (0..self.stencil.len()).all(|r| self.node_checked(r).is_ok())
+    }
 }
 
 /// P2G of one particle on a collocated grid with spacing `h` (m): stencil, mass, momentum,
-/// stress force and heat (see [`P2g`]).
+/// stress force and heat (see [`P2g`]). On success every [`P2g::node`] is finite.
 ///
-/// Errors: invalid material, particle or stencil; the stress kernels' errors.
+/// Errors: invalid material, particle or stencil; the stress kernels' errors;
+/// [`Error::Overflow`] when a node contribution of the finite inputs is not representable
+/// (e.g. `m_p |v_p|`, `m_p c_p T_p`, or a force `∼ V⁰ |τ| / h` beyond the largest finite
+/// value).
 #[inline]
 pub fn p2g<T: Real, const D: usize>(
     material: &Material<T>,
@@ -212,7 +288,7 @@ where
         }
         None => (T::ZERO, T::ZERO, T::ZERO),
     };
-    Ok(P2g {
+    let out = P2g {
         stencil,
         mass: p.mass,
         v: p.v,
@@ -221,7 +297,11 @@ where
         heat_capacity,
         temperature,
         conductivity,
-    })
+    };
+    if !(heat_capacity.is_finite() && conductivity.is_finite() && out.nodes_finite()) {
+        return Err(Error::Overflow);
+    }
+    Ok(out)
 }
 
 /// The grid values G2P reads, gathered by the host in stencil order (see
@@ -234,7 +314,7 @@ pub struct GridSample<'a, T, const D: usize> {
     pub temperature: Option<(&'a [T], &'a [T])>,
 }
 
-/// What [`g2p_update`] did besides the new state.
+/// What [`update_particle`] (and [`g2p_update`]) did besides the new state.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct UpdateInfo<T> {
     /// Halvings used by the remedy for `det(I + Δt∇v) ≤ 0` (0 when it was not needed).
@@ -243,30 +323,31 @@ pub struct UpdateInfo<T> {
     pub heat: HeatSplit<T>,
 }
 
-/// G2P and the particle update of one particle (collocated grid, spacing `h` m, step `Δt` s):
-/// 1. heat (if on): `T* ` by PIC/FLIP; with phase change the heat `q = c (T* − T_p)` goes
-///    through the latent buffer and may switch the phase ([`thermal::absorb`]);
-/// 2. APIC: `v_p`, `C_p`, `∇v_p` ([`apic::gather`]), `x_p ← x_p + Δt v_p`;
-/// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`]);
-/// 4. a liquid drops the deviatoric part of `F_E` ([`liquid_projection`]); a solid with snow
-///    plasticity clamps ([`snow_plasticity`]); an elastic solid does neither.
-///
-/// Returns the new particle; the input is not modified, so a failure leaves it as it was.
-///
-/// Errors: invalid material, particle, `h`, `Δt ≤ 0`, short grid slices, missing temperatures
-/// with heat on ([`Error::InvalidArgument`]); the kernels' errors.
+/// What G2P gathered for one particle from the grid (collocated or MAC): the input of
+/// [`update_particle`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct G2pSample<T, const D: usize> {
+    /// `v_p = Σ w_i v_iⁿ⁺¹` (m/s).
+    pub v: [T; D],
+    /// APIC `C_p = B_p D_p⁻¹` (1/s), column-major.
+    pub affine: Mat<T, D>,
+    /// `∇v_p = Σ v_iⁿ⁺¹ ∇w_iᵀ` (1/s), column-major.
+    pub grad_v: Mat<T, D>,
+    /// `Σ w_i T_iⁿ⁺¹` (K); read only when heat is on.
+    pub t_pic: T,
+    /// `Σ w_i (T_iⁿ⁺¹ − T_iⁿ)` (K); read only when heat is on.
+    pub t_flip: T,
+}
+
+/// The input checks of [`update_particle`] but the temperature: material, particle, `Δt`.
 #[inline]
-pub fn g2p_update<T: Real, const D: usize>(
+fn check_update_inputs<T: Real, const D: usize>(
     material: &Material<T>,
-    kernel: Kernel,
-    h: T,
     dt: T,
-    grid: &GridSample<'_, T, D>,
     p: &Particle<T, D>,
-) -> Result<(Particle<T, D>, UpdateInfo<T>)>
+) -> Result<()>
 where
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-    DefaultSvd: SvdMethod<Mat<T, D>>,
+    Mat<T, D>: Matrix<Scalar = T>,
 {
     material.validate(p.phase)?;
     check_particle(p)?;
@@ -276,34 +357,94 @@ where
     if dt <= T::ZERO {
         return Err(Error::InvalidArgument);
     }
-    let stencil = Stencil::new(kernel, Grid::Collocated, h, &p.x)?;
+    Ok(())
+}
+
+/// The particle's temperature, read when heat is on.
+#[inline]
+fn check_temperature<T: Real, const D: usize>(
+    material: &Material<T>,
+    p: &Particle<T, D>,
+) -> Result<()> {
+    if material.heat.is_some() && !p.temperature.is_finite() {
+        return Err(Error::NonFinite);
+    }
+    Ok(())
+}
+
+/// The particle update of one particle from what G2P gathered (step `Δt` s):
+/// 1. heat (if on): `T*` by PIC/FLIP ([`thermal::blend`] of `s.t_pic`, `s.t_flip`); with
+///    phase change the heat `q = c (T* − T_p)` goes through the latent buffer and may switch
+///    the phase ([`thermal::absorb`]);
+/// 2. APIC: `v_p ← s.v`, `C_p ← s.affine`, `x_p ← x_p + Δt v_p`;
+/// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`]);
+/// 4. a liquid keeps its volume ratios only ([`liquid_projection`]: `F_E ← J_E^{1/d} I`,
+///    `F_P ← J_P^{1/d} I`); a solid with snow plasticity clamps ([`snow_plasticity`]); an
+///    elastic solid does neither.
+///
+/// The phase of step 4 is the one after step 1 (a solid that melts is projected at once).
+/// The new particle is checked as the next call will check it ([`check_particle`],
+/// [`thermal::check_state`] with phase change, [`Material::moduli`]), so `Ok` never carries
+/// a state that a later entry refuses. The input is not modified, so a failure leaves it as
+/// it was. `h` is not known here: the position limit of [`Stencil::new`] is checked by
+/// [`g2p_update`], or by the caller.
+///
+/// Errors: invalid material or particle ([`check_particle`]), `Δt` NaN/inf
+/// ([`Error::NonFinite`]) or `≤ 0` ([`Error::InvalidArgument`]); a NaN/inf value of `s` that
+/// is read ([`Error::NonFinite`]; the temperatures only with heat on); [`Error::Overflow`]
+/// for a new value that is not representable (a temperature, position, `F_E`, `F_P`, their
+/// determinants, or the hardening factor of the new `J_P`); [`Error::NonPositiveJ`] for a new
+/// `F_E` or `F_P` singular to working precision (e.g. the plastic flow of an `F_E` stretched
+/// beyond `~1/ε`); the kernels' errors.
+#[inline]
+pub fn update_particle<T: Real, const D: usize>(
+    material: &Material<T>,
+    dt: T,
+    s: &G2pSample<T, D>,
+    p: &Particle<T, D>,
+) -> Result<(Particle<T, D>, UpdateInfo<T>)>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    check_update_inputs(material, dt, p)?;
+    check_temperature(material, p)?;
+    update_checked(material, dt, s, p)
+}
+
+/// [`update_particle`] after its input checks ([`check_update_inputs`], the temperature).
+#[inline]
+fn update_checked<T: Real, const D: usize>(
+    material: &Material<T>,
+    dt: T,
+    s: &G2pSample<T, D>,
+    p: &Particle<T, D>,
+) -> Result<(Particle<T, D>, UpdateInfo<T>)>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    if !(s.v.iter().all(|c| c.is_finite()) && s.affine.is_finite() && s.grad_v.is_finite()) {
+        return Err(Error::NonFinite);
+    }
     let mut out = *p;
     let mut info = UpdateInfo::default();
 
     // 1. Heat and phase.
     if let Some(heat) = &material.heat {
-        let (t_new, t_old) = grid.temperature.ok_or(Error::InvalidArgument)?;
-        let n = stencil.len();
-        if t_new.len() < n || t_old.len() < n || !p.temperature.is_finite() {
-            return Err(if p.temperature.is_finite() {
-                Error::InvalidArgument
-            } else {
-                Error::NonFinite
-            });
-        }
-        let (mut pic, mut flip) = (T::ZERO, T::ZERO);
-        for r in 0..n {
-            let w = stencil.node(r).weight;
-            pic += w * t_new[r];
-            flip += w * (t_new[r] - t_old[r]);
-        }
-        let t_star = thermal::blend(heat.flip, p.temperature, pic, flip);
-        if !t_star.is_finite() {
+        if !(s.t_pic.is_finite() && s.t_flip.is_finite()) {
             return Err(Error::NonFinite);
+        }
+        let t_star = thermal::blend(heat.flip, p.temperature, s.t_pic, s.t_flip);
+        if !t_star.is_finite() {
+            return Err(Error::Overflow);
         }
         if heat.phase_change {
             let c = material.params(p.phase).heat_capacity;
             let q = c * (t_star - p.temperature);
+            if !q.is_finite() {
+                return Err(Error::Overflow);
+            }
             let st = ThermalState {
                 temperature: p.temperature,
                 latent: p.latent,
@@ -325,19 +466,18 @@ where
         }
     }
 
-    // 2. APIC G2P and advection.
-    let g = gather(&stencil, grid.velocity)?;
-    out.v = g.v;
-    out.affine = g.affine;
+    // 2. APIC velocity, affine matrix and advection.
+    out.v = s.v;
+    out.affine = s.affine;
     for a in 0..D {
-        out.x[a] = p.x[a] + dt * g.v[a];
+        out.x[a] = p.x[a] + dt * s.v[a];
         if !out.x[a].is_finite() {
             return Err(Error::Overflow);
         }
     }
 
     // 3. Elastic deformation gradient, with the remedy.
-    let (f_e, k) = evolve(&p.f_e, &g.grad_v, dt)?;
+    let (f_e, k) = evolve(&p.f_e, &s.grad_v, dt)?;
     info.halvings = k;
 
     // 4. Liquid projection or plasticity.
@@ -348,183 +488,98 @@ where
     };
     out.f_e = f_e;
     out.f_p = f_p;
+
+    check_result(material, &out)?;
     Ok((out, info))
 }
 
-/// The fixed corotated energy of a particle, with its (hardened) `μ`, for [`Stiffness::new`].
-///
-/// Errors: invalid material or particle.
+/// Checks a new particle as the next entry will check it, with the statuses of a result:
+/// a non-finite value or a determinant that under- or overflows is [`Error::Overflow`]
+/// ([`check_det`]), a singular `F_E` or `F_P` [`Error::NonPositiveJ`].
 #[inline]
-pub fn elastic_energy<T: Real, const D: usize>(
-    material: &Material<T>,
-    p: &Particle<T, D>,
-) -> Result<FixedCorotated<T>>
+fn check_result<T: Real, const D: usize>(material: &Material<T>, p: &Particle<T, D>) -> Result<()>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
-    material.validate(p.phase)?;
-    let (_, j_p) = check_particle(p)?;
-    Ok(FixedCorotated::new(material.moduli(p.phase, j_p)?.mu))
+    let j_p = match check_particle(p) {
+        Ok((_, j_p)) => j_p,
+        Err(Error::NonFinite) => return Err(Error::Overflow),
+        Err(Error::NonPositiveJ) => {
+            check_det(&p.f_e)?;
+            check_det(&p.f_p)?;
+            // Unreachable: check_det accepts exactly what check_particle does.
+            return Err(Error::NonPositiveJ);
+        }
+        Err(e) => return Err(e),
+    };
+    if let Some(heat) = &material.heat {
+        if !p.temperature.is_finite() {
+            return Err(Error::Overflow);
+        }
+        if heat.phase_change {
+            thermal::check_state(
+                heat,
+                &ThermalState {
+                    temperature: p.temperature,
+                    latent: p.latent,
+                    phase: p.phase,
+                },
+            )?;
+        }
+    }
+    material.moduli(p.phase, j_p)?;
+    Ok(())
 }
 
-/// The force differential of one particle for an implicit solve: for node displacements
-/// `δu_j` (m; `Δt δv_j` for backward Euler) the particle's `δF_E = G F_E`,
-/// `G = Σ_j δu_j ∇w_jᵀ`, and the node force differentials are
-/// `δf_i = −V⁰ (Ĉ:δF_E + δP_λ) F_Eᵀ ∇w_i` (N), the issue's `δf = −V⁰ (Ĉ:(Σ_j δv_j ∇w_jᵀ F))
-/// Fᵀ ∇w`, with the dilational term [`dilation::d_kirchhoff`] only for
-/// [`Dilation::Explicit`].
+/// G2P and the particle update of one particle (collocated grid, spacing `h` m, step `Δt` s):
+/// the stencil, [`apic::gather`] of the node velocities, [`thermal::gather`] of the node
+/// temperatures (heat on), then [`update_particle`]; finally the new position is checked
+/// against the position limit of [`Stencil::new`] for `h`.
 ///
-/// Built once per particle and time step (one decomposition), applied once per Krylov
-/// iteration. The energy is borrowed, so a Rust host keeps the energies (from
-/// [`elastic_energy`]) alive next to the stiffnesses.
+/// Returns the new particle; the input is not modified, so a failure leaves it as it was.
 ///
-/// With [`Definiteness::Projected`] the material asks for the PSD projection `Ĉ⁺`
-/// ([`crate::hessian::HessianEigensystem::psd`]) in place of `Ĉ`, built once here too.
-/// [`Stiffness::d_force_matrix_with`] takes any other Hessian action in place of `Ĉ:Z`.
-#[derive(Clone, Copy, Debug)]
-pub struct Stiffness<'e, T: Real, const D: usize>
-where
-    Mat<T, D>: Matrix<Scalar = T> + HessianDim,
-    DefaultSvd: SvdMethod<Mat<T, D>>,
-{
-    aug: Option<Augmented<'e, Mat<T, D>, FixedCorotated<T>>>,
-    psd: Option<HessianEigensystem<Mat<T, D>>>,
-    f_e: Mat<T, D>,
-    j_e: T,
-    inv_lambda: Option<T>,
-    volume0: T,
-}
-
-impl<'e, T: Real, const D: usize> Stiffness<'e, T, D>
-where
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]> + HessianDim,
-    DefaultSvd: SvdMethod<Mat<T, D>>,
-{
-    /// Prepares the differential of particle `p` with `energy` (from [`elastic_energy`];
-    /// `μ = 0` skips the deviatoric part and its decomposition), with the material's
-    /// [`Definiteness`].
-    ///
-    /// Errors: invalid material or particle; the kernels' errors.
-    #[inline]
-    pub fn new(
-        energy: &'e FixedCorotated<T>,
-        material: &Material<T>,
-        p: &Particle<T, D>,
-    ) -> Result<Self> {
-        material.validate(p.phase)?;
-        let (j_e, j_p) = check_particle(p)?;
-        let (aug, psd) = match (energy.mu == T::ZERO, material.hessian) {
-            (true, _) => (None, None),
-            (false, Definiteness::Exact) => (Some(Augmented::new(energy, &p.f_e)?), None),
-            (false, Definiteness::Projected) => {
-                (None, Some(HessianEigensystem::new(energy, &p.f_e)?.psd()?))
-            }
-        };
-        let inv_lambda = match material.dilation {
-            Dilation::Explicit => Some(material.moduli(p.phase, j_p)?.inv_lambda),
-            Dilation::PressureSolve => None,
-        };
-        Ok(Self {
-            aug,
-            psd,
-            f_e: p.f_e,
-            j_e,
-            inv_lambda,
-            volume0: p.volume0,
-        })
-    }
-
-    /// `−V⁰ (Ĉ:(G F_E) + δP_λ) F_Eᵀ` (N·m), `Ĉ⁺` with [`Definiteness::Projected`]: the node
-    /// force differential is this times `∇w_i`.
-    #[inline]
-    pub fn d_force_matrix(&self, g: &Mat<T, D>) -> Result<Mat<T, D>> {
-        if let Some(psd) = &self.psd {
-            if !g.is_finite() {
-                return Err(Error::NonFinite);
-            }
-            let mut m = psd.apply(&(*g * self.f_e))? * self.f_e.transpose();
-            if let Some(il) = self.inv_lambda {
-                m += dilation::d_kirchhoff(self.j_e, il, g)?;
-            }
-            return self.finish(m);
-        }
-        self.d_force_matrix_with(g, |aug, z| aug.chat_z(z))
-    }
-
-    #[inline]
-    fn finish(&self, m: Mat<T, D>) -> Result<Mat<T, D>> {
-        let m = m * (-self.volume0);
-        if m.is_finite() {
-            Ok(m)
-        } else {
-            Err(Error::Overflow)
-        }
-    }
-
-    /// As [`Stiffness::d_force_matrix`] with `chat(aug, Z)` in place of `Ĉ:Z` (called only
-    /// when `μ > 0` and the material's Hessian is [`Definiteness::Exact`]).
-    #[inline]
-    pub fn d_force_matrix_with(
-        &self,
-        g: &Mat<T, D>,
-        chat: impl FnOnce(&Augmented<'e, Mat<T, D>, FixedCorotated<T>>, &Mat<T, D>) -> Result<Mat<T, D>>,
-    ) -> Result<Mat<T, D>> {
-        if !g.is_finite() {
-            return Err(Error::NonFinite);
-        }
-        let mut m = Mat::<T, D>::ZERO;
-        if let Some(aug) = &self.aug {
-            let df = *g * self.f_e;
-            m = chat(aug, &df)? * self.f_e.transpose();
-        }
-        if let Some(il) = self.inv_lambda {
-            m += dilation::d_kirchhoff(self.j_e, il, g)?;
-        }
-        self.finish(m)
-    }
-
-    /// Applies the differential on the particle's stencil: reads `du[r]` (m), writes `df[r]`
-    /// (N) for every node `r`, only on success.
-    ///
-    /// Errors: [`Error::InvalidArgument`] for slices shorter than the stencil; the kernels'.
-    #[inline]
-    pub fn apply(&self, s: &Stencil<T, D>, du: &[[T; D]], df: &mut [[T; D]]) -> Result<()> {
-        let n = s.len();
-        if du.len() < n || df.len() < n {
-            return Err(Error::InvalidArgument);
-        }
-        let mut g = Mat::<T, D>::ZERO;
-        for (r, u) in du.iter().enumerate().take(n) {
-            g += Mat::outer(*u, s.node(r).grad);
-        }
-        let m = self.d_force_matrix(&g)?;
-        for (r, out) in df.iter_mut().enumerate().take(n) {
-            *out = m.mul_vec(s.node(r).grad);
-        }
-        Ok(())
-    }
-}
-
-/// One-shot force differential of a particle on its collocated stencil (see [`Stiffness`]):
-/// builds the energy and the stiffness, then applies them to `du` (m), writing `df` (N).
-///
-/// Errors: as [`Stiffness::new`] and [`Stiffness::apply`].
+/// Errors: invalid material, particle, `h`, `Δt ≤ 0`, short grid slices, missing temperatures
+/// with heat on ([`Error::InvalidArgument`]); those of the gathers (NaN/inf node values
+/// [`Error::NonFinite`], sums that overflow or a tiny `h` [`Error::Overflow`]); those of
+/// [`update_particle`]; [`Error::Overflow`] when the new position is beyond the position
+/// limit `|x/h| < 2³⁰`.
 #[inline]
-pub fn force_differential<T: Real, const D: usize>(
+pub fn g2p_update<T: Real, const D: usize>(
     material: &Material<T>,
     kernel: Kernel,
     h: T,
+    dt: T,
+    grid: &GridSample<'_, T, D>,
     p: &Particle<T, D>,
-    du: &[[T; D]],
-    df: &mut [[T; D]],
-) -> Result<()>
+) -> Result<(Particle<T, D>, UpdateInfo<T>)>
 where
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]> + HessianDim,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    let s = Stencil::new(kernel, Grid::Collocated, h, &p.x)?;
-    let e = elastic_energy(material, p)?;
-    Stiffness::new(&e, material, p)?.apply(&s, du, df)
+    check_update_inputs(material, dt, p)?;
+    let stencil = Stencil::new(kernel, Grid::Collocated, h, &p.x)?;
+    let (t_pic, t_flip) = match material.heat {
+        Some(_) => {
+            let (t_new, t_old) = grid.temperature.ok_or(Error::InvalidArgument)?;
+            check_temperature(material, p)?;
+            thermal::gather(&stencil, t_new, t_old)?
+        }
+        None => (T::ZERO, T::ZERO),
+    };
+    let g = gather(&stencil, grid.velocity)?;
+    let sample = G2pSample {
+        v: g.v,
+        affine: g.affine,
+        grad_v: g.grad_v,
+        t_pic,
+        t_flip,
+    };
+    let (out, info) = update_checked(material, dt, &sample, p)?;
+    if Stencil::<T, D>::check_position(Grid::Collocated, h, &out.x).is_err() {
+        // The cell index of the new position is beyond the supported range.
+        return Err(Error::Overflow);
+    }
+    Ok((out, info))
 }
 
 /// The particle pressure `p = −Ψ_λ'(J_E)/J_P` (Pa) with the particle's (hardened) `λ`
@@ -557,4 +612,83 @@ where
     material.validate(p.phase)?;
     let (j_e, j_p) = check_particle(p)?;
     dilation::pressure_coefficient(j_e, j_p, material.moduli(p.phase, j_p)?.inv_lambda, dt)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn plastic() -> Material<f32> {
+        Material {
+            plasticity: Some(super::super::Snow {
+                critical_compression: 0.025,
+                critical_stretch: 0.0075,
+                hardening: 10.0,
+            }),
+            ..Material::elastic(10.0, 10.0)
+        }
+    }
+
+    fn still() -> G2pSample<f32, 2> {
+        G2pSample {
+            v: [0.0; 2],
+            affine: Mat::ZERO,
+            grad_v: Mat::ZERO,
+            t_pic: f32::NAN,
+            t_flip: f32::NAN,
+        }
+    }
+
+    /// `J_P = 2⁻¹²⁶` compressed by `(2⁻¹⁶/0.975)²` underflows to 0: Overflow, not `Ok`.
+    #[test]
+    fn j_p_underflow_is_overflow() {
+        let mut p = Particle::<f32, 2>::at_rest([0.3; 2], 1.0, 1.0);
+        p.f_p = Mat::from_diagonal([2f32.powi(-63); 2]);
+        p.f_e = Mat::from_diagonal([2f32.powi(-16); 2]);
+        assert!(check_particle(&p).is_ok());
+        assert_eq!(
+            update_particle(&plastic(), 1e-3, &still(), &p).map(|_| ()),
+            Err(Error::Overflow)
+        );
+    }
+
+    /// An `F_E` and `F_P` stretched past `1/ε`: the plastic flow's `F_P` loses its
+    /// determinant (refused); the liquid projection needs the determinants only (kept).
+    #[test]
+    fn ill_conditioned_flow() {
+        let mut p = Particle::<f32, 2>::at_rest([0.3; 2], 1.0, 1.0);
+        p.f_e = Mat::from_cols([[-843.1956, -1033.6561], [-235.58327, -288.79782]]);
+        p.f_p = Mat::from_cols([[-566.16144, -1102.0168], [282.9347, 550.7224]]);
+        assert!(check_particle(&p).is_ok());
+        let r = update_particle(&plastic(), 1e-3, &still(), &p);
+        assert!(
+            matches!(r, Err(Error::NonPositiveJ | Error::Overflow)),
+            "{r:?}"
+        );
+        p.phase = Phase::Liquid;
+        let liquid = Material {
+            liquid: super::super::PhaseParams {
+                inv_lambda: 0.1,
+                ..Default::default()
+            },
+            ..Material::default()
+        };
+        let (q, _) = update_particle(&liquid, 1e-3, &still(), &p).unwrap();
+        assert!(check_particle(&q).is_ok());
+    }
+
+    /// `m |v| > MAX`: Overflow, where every node used to be written as inf.
+    #[test]
+    fn p2g_momentum_overflow() {
+        let mut p = Particle::<f32, 2>::at_rest([0.3; 2], 1e30, 1.0);
+        p.v = [1e10, 0.0];
+        let m = Material::elastic(10.0, 10.0);
+        assert_eq!(
+            p2g(&m, Kernel::Quadratic, 0.5, &p).map(|_| ()),
+            Err(Error::Overflow)
+        );
+        p.v = [1e7, 0.0];
+        let q = p2g(&m, Kernel::Quadratic, 0.5, &p).unwrap();
+        assert!((0..q.stencil.len()).all(|r| q.node_checked(r).is_ok()));
+    }
 }

@@ -1,0 +1,321 @@
+//! The force differential of an implicit step through a grid view: [`prepare`] once per Newton
+//! step, [`apply`] once per Krylov iteration (the math is in [`crate::particle::implicit`]).
+//!
+//! `apply` maps node displacements `δu_j` (m; `Δt δv_j` for backward Euler) to node force
+//! differentials `δf_i = Σ_p M_p ∇w_ip` (N), `M_p = 𝒜_p(Σ_j δu_j ∇w_jpᵀ)`, scatter-added into the
+//! `df` channels: the host zeroes them before the call. This is `δf = K δu` with the stiffness
+//! `K = ∂f/∂x` (symmetric; negative semi-definite with the projected Hessian). A backward-Euler
+//! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
+//! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
+
+use super::nodes::{nodes, off, rel_base, table, taint};
+use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
+use super::{Particles, Reads};
+use crate::error::{Error, Result};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
+use crate::kernel::chunk::check_bits;
+use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
+use crate::lane::lmat::LMat;
+use crate::lane::{Isa, Lane};
+use crate::mat::{Mat, Matrix};
+use crate::particle::implicit::{apply_slot, blocks, entries, slot_len, tag};
+use crate::particle::stencil::{Grid, Kernel, Stencil};
+use crate::particle::update::check_particle;
+use crate::particle::{Definiteness, Dilation, Material};
+use crate::scalar::Real;
+use core::ptr;
+
+/// The channels of the force differential: displacements read, force differentials added.
+#[derive(Clone, Copy, Debug)]
+pub struct ForceView<T, const D: usize> {
+    /// The nodes the channels cover.
+    pub nodes: NodeBox<D>,
+    /// Node displacements `δu` per axis (m).
+    pub du: [InChannel<T, D>; D],
+    /// Node force differentials `δf` per axis (N), scatter-added.
+    pub df: [OutChannel<T, D>; D],
+}
+
+/// Prepares the force differential of `n` particles into `slots` (`n·`[`slot_len`]`(d)`
+/// scalars): reads `f_e`, `f_p`, `volume0`, `phase` (and `latent` with phase change). A failed
+/// particle's slot gets tag 0 only, so that [`apply`] refuses it.
+///
+/// Errors per particle: invalid particle or material, the kernels' errors, [`Error::Overflow`].
+/// Whole-call errors (a null array the material needs) are reported for particle 0.
+///
+/// # Safety
+/// The arrays hold `n` particles; `slots` is valid for `n·slot_len(d)` scalars.
+pub unsafe fn prepare<T: BatchReal, const D: usize>(
+    isa: Isa,
+    material: &Material<T>,
+    n: usize,
+    ps: &Particles<T>,
+    slots: *mut T,
+) -> BatchStatus
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let reads = Reads {
+        x: false,
+        motion: false,
+        mass: false,
+    };
+    if n > 0 && (!ps.has(reads, material) || slots.is_null()) {
+        return BatchStatus {
+            first_failed: 0,
+            error: Some(Error::InvalidArgument),
+        };
+    }
+    let mut op = PrepareOp::<T, D> {
+        material,
+        checked: Checked::new(material),
+        n,
+        ps,
+        slots,
+        first: FirstFailure::new(n),
+    };
+    dispatch::<T, _>(isa, &mut op);
+    op.first.status()
+}
+
+struct PrepareOp<'a, T, const D: usize> {
+    material: &'a Material<T>,
+    checked: Checked,
+    n: usize,
+    ps: &'a Particles<T>,
+    slots: *mut T,
+    first: FirstFailure,
+}
+
+/// Per particle: `F_E`, `μ`, `α`, `β`, `−V⁰`.
+type Pre<T, const D: usize> = (Mat<T, D>, [T; 4]);
+
+impl<T: BatchReal, const D: usize> PrepareOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
+        let reads = Reads {
+            x: false,
+            motion: false,
+            mass: false,
+        };
+        let p = self.ps.get::<D>(i, reads, self.material)?;
+        self.checked.for_phase(p.phase)?;
+        let (j, j_p) = check_particle(&p)?;
+        let m = self.material.moduli(p.phase, j_p)?;
+        let (alpha, beta) = match self.material.dilation {
+            Dilation::Explicit => {
+                let lj = j / m.inv_lambda;
+                (lj * (j + j - T::ONE), -(lj * (j - T::ONE)))
+            }
+            Dilation::PressureSolve => (T::ZERO, T::ZERO),
+        };
+        if !(alpha.is_finite() && beta.is_finite()) {
+            return Err(Error::Overflow);
+        }
+        Ok((p.f_e, [m.mu, alpha, beta, -p.volume0]))
+    }
+}
+
+impl<T: BatchReal, const D: usize> LaneOp<T> for PrepareOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline(always)]
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        let lanes = V::LANES;
+        let sl = slot_len(D);
+        let psd = self.material.hessian == Definiteness::Projected;
+        let mut start = 0;
+        while start < self.n {
+            let len = lanes.min(self.n - start);
+            let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
+            let mut sbuf = [[T::ZERO; MAX_LANES]; 4];
+            let mut err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            for l in 0..lanes {
+                let pre = if l < len {
+                    // SAFETY: `prepare`'s contract.
+                    unsafe { self.pre(start + l) }
+                } else {
+                    Err(Error::InvalidArgument)
+                };
+                match pre {
+                    Ok((f, s)) => {
+                        for j in 0..D {
+                            for r in 0..D {
+                                fbuf[r + D * j][l] = f.cols[j][r];
+                            }
+                        }
+                        for (k, x) in s.iter().enumerate() {
+                            sbuf[k][l] = *x;
+                        }
+                    }
+                    Err(e) => {
+                        err[l] = Some(e);
+                        for d in 0..D {
+                            fbuf[d * (D + 1)][l] = T::ONE;
+                        }
+                    }
+                }
+            }
+            let mut f: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
+            for j in 0..D {
+                for r in 0..D {
+                    f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
+                }
+            }
+            let [mu, alpha, beta, nv] = [0, 1, 2, 3].map(|k| V::load(&sbuf[k][..lanes]));
+            let (co, ck) = evaluate(mu, &f);
+            let b = blocks(&co, alpha, beta, nv, psd);
+            let bits = check_bits::<V>(&ck);
+            let mut out = [[T::ZERO; MAX_LANES]; 25];
+            let mut chk = V::splat(T::ZERO);
+            entries(&b, |o, v| {
+                chk += v - v;
+                v.store(&mut out[o][..lanes]);
+            });
+            let mut ok_bits = [T::ZERO; MAX_LANES];
+            chk.store(&mut ok_bits[..lanes]);
+            for l in 0..len {
+                let i = start + l;
+                let mut e = err[l];
+                if e.is_none() && sbuf[0][l] > T::ZERO {
+                    e = lane_error(&bits, l);
+                }
+                if e.is_none() && !ok_bits[l].is_finite() {
+                    e = Some(Error::Overflow);
+                }
+                // SAFETY: `prepare`'s contract: `n` slots.
+                unsafe {
+                    let slot = self.slots.add(i * sl);
+                    match e {
+                        None => {
+                            for (o, row) in out.iter().enumerate().take(sl).skip(1) {
+                                ptr::write_unaligned(slot.add(o), row[l]);
+                            }
+                            ptr::write_unaligned(slot, tag::<T>(D));
+                        }
+                        Some(_) => ptr::write_unaligned(slot, T::ZERO),
+                    }
+                }
+                self.first.note(i, e.map_or(Ok(()), Err));
+            }
+            start += len;
+        }
+        self.first.status()
+    }
+}
+
+/// Applies the prepared differential of `n` particles at positions `x` (`n·d`, m; the positions
+/// of the prepare's Newton step) to `view.du`, adding `δf` into `view.df` (collocated grid,
+/// spacing `h`).
+///
+/// Errors per particle: [`Error::NotPrepared`] for a slot no successful prepare wrote, the
+/// stencil's errors, [`Error::OutsideGrid`], [`Error::NonFinite`] for a non-finite `δu` read,
+/// [`Error::Overflow`] for a `δf` that would not be finite. Whole-call errors (null `x`,
+/// `slots` or channel) are reported for particle 0.
+///
+/// # Safety
+/// `x` holds `n·d` scalars, `slots` `n·slot_len(d)`; every channel is valid at every node of
+/// `view.nodes`; `df` channels do not alias `du` channels or the slots.
+pub unsafe fn apply<T: Real, const D: usize>(
+    kernel: Kernel,
+    h: T,
+    n: usize,
+    x: *const T,
+    slots: *const T,
+    view: &ForceView<T, D>,
+) -> BatchStatus
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let missing = view.du.iter().any(|c| c.data.is_null())
+        || view.df.iter().any(|c| c.data.is_null())
+        || (n > 0 && (x.is_null() || slots.is_null()));
+    if missing {
+        return BatchStatus {
+            first_failed: 0,
+            error: Some(Error::InvalidArgument),
+        };
+    }
+    let sl = slot_len(D);
+    let mut first = FirstFailure::new(n);
+    for i in 0..n {
+        let slot = core::slice::from_raw_parts(slots.add(i * sl), sl);
+        let r = if slot[0] != tag::<T>(D) {
+            Err(Error::NotPrepared)
+        } else {
+            let xp = rd_vec::<T, D>(x, i);
+            match kernel {
+                Kernel::Quadratic => one::<T, D, 3>(kernel, h, &xp, slot, view),
+                Kernel::Cubic => one::<T, D, 4>(kernel, h, &xp, slot, view),
+            }
+        };
+        first.note(i, r);
+    }
+    first.status()
+}
+
+#[inline(always)]
+unsafe fn one<T: Real, const D: usize, const K: usize>(
+    kernel: Kernel,
+    h: T,
+    x: &[T; D],
+    slot: &[T],
+    view: &ForceView<T, D>,
+) -> Result<()>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let s = Stencil::new(kernel, Grid::Collocated, h, x)?;
+    let rel = rel_base(&s, &view.nodes)?;
+    let tu: [[[isize; 4]; D]; D] = core::array::from_fn(|a| table(&view.du[a], &rel));
+    let tf: [[[isize; 4]; D]; D] = core::array::from_fn(|a| table(&view.df[a], &rel));
+    let nd = nodes::<T, D, K>(&s);
+    let mut g = Mat::<T, D>::ZERO;
+    let mut chk = true;
+    for r in 0..nd.n {
+        let (o, gr) = (nd.o[r], nd.g[r]);
+        for a in 0..D {
+            let u = ptr::read_unaligned(view.du[a].data.offset(off(&tu[a], &o)));
+            taint(&mut chk, u);
+            for b in 0..D {
+                g.cols[b][a] += u * gr[b];
+            }
+        }
+    }
+    if !chk {
+        return Err(Error::NonFinite);
+    }
+    let m = apply_slot(slot, &g);
+    let nn = nd.n;
+    let mut old = [core::mem::MaybeUninit::<T>::uninit(); 64 * 3];
+    for r in 0..nn {
+        let o = nd.o[r];
+        let f = m.mul_vec(nd.g[r]);
+        for a in 0..D {
+            let p = view.df[a].data.offset(off(&tf[a], &o));
+            let x = ptr::read_unaligned(p);
+            old[r * D + a].write(x);
+            let nv = x + f[a];
+            taint(&mut chk, nv);
+            ptr::write_unaligned(p, nv);
+        }
+    }
+    if !chk {
+        // Put the old values back, last written first.
+        for r in (0..nn).rev() {
+            let o = nd.o[r];
+            for a in (0..D).rev() {
+                // SAFETY: written above.
+                let x = old[r * D + a].assume_init();
+                ptr::write_unaligned(view.df[a].data.offset(off(&tf[a], &o)), x);
+            }
+        }
+        return Err(Error::Overflow);
+    }
+    Ok(())
+}

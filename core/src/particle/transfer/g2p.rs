@@ -1,0 +1,275 @@
+//! G2P from a grid view and the particle update.
+//!
+//! Per particle (Jiang et al. 2015, §5.3 and §6 for MAC grids): `v_p = Σ w_i v_i`,
+//! `C_p = Σ w_i v_i (x_i − x_p)ᵀ / (κ h²)` (`κ` = [`Kernel::apic_moment`]), `∇v_p = Σ v_i ∇w_iᵀ`,
+//! and with heat on `T_pic = Σ w_i T_iⁿ⁺¹`, `ΔT_flip = Σ w_i (T_iⁿ⁺¹ − T_iⁿ)`; then
+//! [`update_particle`] (temperature and phase, advection, `F_E` with its remedy, the liquid
+//! projection or snow plasticity). On a MAC grid component `a` of `v_p`, row `a` of `C_p` and
+//! of `∇v_p` come from face grid `a` with its own stencil; temperatures stay collocated.
+//!
+//! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
+//! per-node subtraction.
+
+use super::nodes::{nodes, off, rel_base, table, taint};
+use super::{BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
+use crate::error::{Error, Result};
+use crate::mat::{Mat, Matrix};
+use crate::particle::stencil::{Grid, Kernel, Stencil};
+use crate::particle::update::{update_particle, G2pSample};
+use crate::particle::Material;
+use crate::polar::{DefaultSvd, SvdMethod};
+use crate::scalar::Real;
+use core::ptr;
+
+/// Where G2P reads: a node box and its channels.
+#[derive(Clone, Copy, Debug)]
+pub struct G2pView<T, const D: usize> {
+    /// The nodes the channels cover.
+    pub nodes: NodeBox<D>,
+    /// New node velocities `v_iⁿ⁺¹` per axis (m/s).
+    pub velocity: [InChannel<T, D>; D],
+    /// New node temperatures `T_iⁿ⁺¹` (K); read with heat on.
+    pub temperature: InChannel<T, D>,
+    /// Old node temperatures `T_iⁿ` (K); read with heat on.
+    pub temperature_old: InChannel<T, D>,
+}
+
+/// The parameters of a G2P call.
+#[derive(Clone, Copy, Debug)]
+pub struct G2pArgs<T> {
+    /// Interpolation kernel.
+    pub kernel: Kernel,
+    /// Grid spacing `h` (m).
+    pub h: T,
+    /// Time step `Δt > 0` (s).
+    pub dt: T,
+}
+
+/// G2P and the update of `n` particles. `view` is the collocated grid (velocities and, with
+/// heat on, temperatures); with `faces` (a MAC grid) velocity component `a` is read from
+/// `faces[a].velocity[a]` on face grid `a` instead, and `view`'s velocities are not read.
+///
+/// Reads every particle array the material needs; writes `x, v, affine, f_e, f_p`, and
+/// `temperature`, `latent`, `phase` as the material says. A failed particle keeps its state.
+///
+/// Errors per particle: those of [`update_particle`], [`Error::OutsideGrid`],
+/// [`Error::NonFinite`] for a non-finite node value that the particle reads, [`Error::Overflow`]
+/// for sums that overflow. Whole-call errors (a null array the material needs, a null velocity
+/// channel, null temperature channels with heat on) are reported for particle 0.
+///
+/// # Safety
+/// The arrays of `ps` hold `n` particles; every channel read is valid at every node of its
+/// box; no channel aliases a particle array.
+pub unsafe fn g2p_update<T: Real, const D: usize>(
+    material: &Material<T>,
+    args: &G2pArgs<T>,
+    n: usize,
+    ps: &Particles<T>,
+    view: &G2pView<T, D>,
+    faces: Option<&[G2pView<T, D>; D]>,
+) -> BatchStatus
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let bad = |e| BatchStatus {
+        first_failed: 0,
+        error: Some(e),
+    };
+    let reads = Reads {
+        x: true,
+        motion: true,
+        mass: true,
+    };
+    let heat = material.heat.is_some();
+    let vel_missing = match faces {
+        Some(f) => (0..D).any(|a| f[a].velocity[a].data.is_null()),
+        None => view.velocity.iter().any(|c| c.data.is_null()),
+    };
+    let missing = (n > 0 && !ps.has(reads, material))
+        || vel_missing
+        || (heat && (view.temperature.data.is_null() || view.temperature_old.data.is_null()));
+    if missing {
+        return bad(Error::InvalidArgument);
+    }
+    let checked = Checked::new(material);
+    let mut first = FirstFailure::new(n);
+    for i in 0..n {
+        let r = one(material, &checked, args, ps, view, faces, i);
+        first.note(i, r);
+    }
+    first.status()
+}
+
+#[inline(always)]
+unsafe fn one<T: Real, const D: usize>(
+    material: &Material<T>,
+    checked: &Checked,
+    args: &G2pArgs<T>,
+    ps: &Particles<T>,
+    view: &G2pView<T, D>,
+    faces: Option<&[G2pView<T, D>; D]>,
+    i: usize,
+) -> Result<()>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let reads = Reads {
+        x: true,
+        motion: true,
+        mass: true,
+    };
+    let p = ps.get::<D>(i, reads, material)?;
+    checked.for_phase(p.phase)?;
+    let k = args.kernel;
+    let sample = match k {
+        Kernel::Quadratic => sample::<T, D, 3>(material, args, &p.x, view, faces)?,
+        Kernel::Cubic => sample::<T, D, 4>(material, args, &p.x, view, faces)?,
+    };
+    let (out, _) = update_particle(material, args.dt, &sample, &p)?;
+    if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
+        // The cell index of the new position is beyond the supported range (as g2p_update).
+        return Err(Error::Overflow);
+    }
+    ps.put(i, material, &out);
+    Ok(())
+}
+
+/// Sums over the velocity channels of one stencil (components `comps`): per component
+/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite.
+#[inline(always)]
+unsafe fn sums<T: Real, const D: usize, const K: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
+    ch: &[InChannel<T, D>; D],
+    comps: (usize, usize),
+) -> ([T; D], [[T; D]; D], [[T; D]; D], bool) {
+    let mut v = [T::ZERO; D];
+    let mut so = [[T::ZERO; D]; D];
+    let mut g = [[T::ZERO; D]; D];
+    let mut chk = true;
+    let mut tabs = [[[0isize; 4]; D]; D];
+    for a in comps.0..comps.1 {
+        tabs[a] = table(&ch[a], rel);
+    }
+    let oc: [T; 4] = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
+    let nd = nodes::<T, D, K>(s);
+    for r in 0..nd.n {
+        let (o, w, gr) = (nd.o[r], nd.w[r], nd.g[r]);
+        for a in comps.0..comps.1 {
+            let q = ptr::read_unaligned(ch[a].data.offset(off(&tabs[a], &o)));
+            taint(&mut chk, q);
+            let wq = w * q;
+            v[a] += wq;
+            for b in 0..D {
+                so[a][b] += wq * oc[o[b]];
+                g[a][b] += q * gr[b];
+            }
+        }
+    }
+    (v, so, g, chk)
+}
+
+/// `Σ w Tⁿ⁺¹` and `Σ w (Tⁿ⁺¹ − Tⁿ)` (the node difference is exact when the two are within a
+/// factor 2, Sterbenz), and whether every value read was finite.
+#[inline(always)]
+unsafe fn temperatures<T: Real, const D: usize, const K: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
+    new: &InChannel<T, D>,
+    old: &InChannel<T, D>,
+) -> (T, T, bool) {
+    let (mut pic, mut flip, mut chk) = (T::ZERO, T::ZERO, true);
+    let (tn, to) = (table(new, rel), table(old, rel));
+    let nd = nodes::<T, D, K>(s);
+    for r in 0..nd.n {
+        let (o, w) = (nd.o[r], nd.w[r]);
+        let a = ptr::read_unaligned(new.data.offset(off(&tn, &o)));
+        let b = ptr::read_unaligned(old.data.offset(off(&to, &o)));
+        taint(&mut chk, a);
+        taint(&mut chk, b);
+        pic += w * a;
+        flip += w * (a - b);
+    }
+    (pic, flip, chk)
+}
+
+/// The grid sample of a particle at `x`.
+#[inline(always)]
+unsafe fn sample<T: Real, const D: usize, const K: usize>(
+    material: &Material<T>,
+    args: &G2pArgs<T>,
+    x: &[T; D],
+    view: &G2pView<T, D>,
+    faces: Option<&[G2pView<T, D>; D]>,
+) -> Result<G2pSample<T, D>>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let s = Stencil::new(args.kernel, Grid::Collocated, args.h, x)?;
+    // The collocated box is read for velocities (collocated grid) and temperatures (heat on).
+    let rel = if faces.is_none() || material.heat.is_some() {
+        rel_base(&s, &view.nodes)?
+    } else {
+        [0; D]
+    };
+    // 1/(κ h): C_p = (Σ w v oᵀ − v fxᵀ)/(κ h).
+    let inv_kh = T::ONE / (args.kernel.apic_moment::<T>() * args.h);
+    if !inv_kh.is_finite() {
+        return Err(Error::Overflow);
+    }
+    let mut out = G2pSample {
+        v: [T::ZERO; D],
+        affine: Mat::ZERO,
+        grad_v: Mat::ZERO,
+        t_pic: T::ZERO,
+        t_flip: T::ZERO,
+    };
+    let mut finite = true;
+    let mut put = |a: usize, st: &Stencil<T, D>, v: &[T; D], so: &[[T; D]; D], g: &[[T; D]; D]| {
+        out.v[a] = v[a];
+        for b in 0..D {
+            out.affine.cols[b][a] = (so[a][b] - v[a] * st.fx[b]) * inv_kh;
+            out.grad_v.cols[b][a] = g[a][b];
+        }
+    };
+    match faces {
+        None => {
+            let (v, so, g, ok) = sums::<T, D, K>(&s, &rel, &view.velocity, (0, D));
+            finite &= ok;
+            for a in 0..D {
+                put(a, &s, &v, &so, &g);
+            }
+        }
+        Some(f) => {
+            for a in 0..D {
+                let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
+                let rl = rel_base(&st, &f[a].nodes)?;
+                let (v, so, g, ok) = sums::<T, D, K>(&st, &rl, &f[a].velocity, (a, a + 1));
+                finite &= ok;
+                put(a, &st, &v, &so, &g);
+            }
+        }
+    }
+    if material.heat.is_some() {
+        let (pic, flip, ok) =
+            temperatures::<T, D, K>(&s, &rel, &view.temperature, &view.temperature_old);
+        finite &= ok;
+        out.t_pic = pic;
+        out.t_flip = flip;
+    }
+    if !finite {
+        return Err(Error::NonFinite);
+    }
+    let mut chk = true;
+    for a in 0..D {
+        taint(&mut chk, out.v[a]);
+    }
+    taint(&mut chk, out.t_pic);
+    taint(&mut chk, out.t_flip);
+    if !(chk && out.affine.is_finite() && out.grad_v.is_finite()) {
+        return Err(Error::Overflow);
+    }
+    Ok(out)
+}

@@ -1,0 +1,402 @@
+//! P2G into a grid view: node masses, APIC momenta, stress forces and heat, scatter-added.
+//!
+//! Per particle `p` and stencil node `i` (Jiang et al. 2015 for APIC, Stomakhin et al. 2013
+//! eq. 6 and 2014 §5–§6 for the forces and heat; formulas as in [`crate::particle::update`]):
+//! - mass `w m`; momentum `w m (v + C (x_i − x_p)) + Δt_f f_i` (`Δt_f` = [`P2gArgs::impulse_dt`],
+//!   0 for the plain momentum; `Δt` gives the symplectic-Euler form `m v* + Δt f`);
+//! - force `f_i = −V⁰ τ ∇w_i`, `τ = Â F_Eᵀ + λ(J_E − 1)J_E I` (the dilational term only when
+//!   the dilation is explicit; `Â` only when `μ > 0`, so a liquid runs no decomposition);
+//! - heat capacity `w m c`, thermal energy `w m c T`, conductivity mass `w m κ` (heat on).
+//!
+//! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
+//! node loop is per particle.
+
+use super::nodes::{nodes, off, rel_base, table, taint};
+use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
+use crate::error::{Error, Result};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
+use crate::kernel::chunk::check_bits;
+use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
+use crate::lane::lmat::{mul_nt, LMat};
+use crate::lane::{Isa, Lane};
+use crate::mat::{Mat, Matrix};
+use crate::particle::dilation;
+use crate::particle::stencil::{Grid, Kernel, Stencil};
+use crate::particle::update::check_particle;
+use crate::particle::{Dilation, Material, Particle};
+use core::ptr;
+
+/// Where P2G writes: a node box and the channels to scatter-add into (absent channels are
+/// skipped). On a MAC face grid `a` only `mass`, `momentum[a]` and `force[a]` are written.
+#[derive(Clone, Copy, Debug)]
+pub struct P2gView<T, const D: usize> {
+    /// The nodes the channels cover.
+    pub nodes: NodeBox<D>,
+    /// Node mass (kg).
+    pub mass: OutChannel<T, D>,
+    /// Node momentum per axis (kg·m/s), plus `impulse_dt · force`.
+    pub momentum: [OutChannel<T, D>; D],
+    /// Node stress force per axis (N).
+    pub force: [OutChannel<T, D>; D],
+    /// Node heat capacity `Σ w m c` (J/K); heat on, collocated grid.
+    pub heat_capacity: OutChannel<T, D>,
+    /// Node thermal energy `Σ w m c T` (J); heat on, collocated grid.
+    pub thermal_energy: OutChannel<T, D>,
+    /// Node conductivity mass `Σ w m κ` (kg·W/(m·K)); heat on, collocated grid.
+    pub conductivity: OutChannel<T, D>,
+}
+
+/// The parameters of a P2G call.
+#[derive(Clone, Copy, Debug)]
+pub struct P2gArgs<T> {
+    /// Interpolation kernel.
+    pub kernel: Kernel,
+    /// Collocated grid or one MAC face grid.
+    pub grid: Grid,
+    /// Grid spacing `h` (m).
+    pub h: T,
+    /// `Δt_f ≥ 0` (s): the momentum channel also receives `Δt_f f_i`.
+    pub impulse_dt: T,
+}
+
+const CH: usize = 10; // mass, momentum ×3, force ×3, heat capacity, thermal energy, conductivity
+
+/// A particle ready for its node loop.
+#[derive(Clone, Copy)]
+struct Ready<T, const D: usize> {
+    s: Stencil<T, D>,
+    /// `m v − m C h fx`: the momentum density at offset 0.
+    q0: [T; D],
+    /// `m C h`: the momentum density grows by column `b` per unit offset along `b`.
+    mch: Mat<T, D>,
+    /// `−V⁰ τ` (N·m).
+    fm: Mat<T, D>,
+    mass: T,
+    heat: [T; 3],
+}
+
+/// P2G of `n` particles into `view` (see the module docs). Reads `x, v, affine, f_e, f_p,
+/// mass, volume0`, `temperature` with heat on, `phase` (if non-null).
+///
+/// Errors per particle as [`crate::particle::update::p2g`], plus [`Error::OutsideGrid`] and
+/// [`Error::Overflow`] for a node value that would not be finite. A whole-call error (material
+/// flags, a null array the material needs, `impulse_dt` not finite or negative, a face axis
+/// `≥ d`) is reported for particle 0 and nothing is written.
+///
+/// # Safety
+/// The arrays of `ps` that the material needs hold `n` particles; each non-null channel is
+/// valid for reading and writing at every node of `view.nodes`; no channel aliases a particle
+/// array.
+pub unsafe fn p2g<T: BatchReal, const D: usize>(
+    isa: Isa,
+    material: &Material<T>,
+    args: &P2gArgs<T>,
+    n: usize,
+    ps: &Particles<T>,
+    view: &P2gView<T, D>,
+) -> BatchStatus
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let bad = |e| BatchStatus {
+        first_failed: 0,
+        error: Some(e),
+    };
+    if !args.impulse_dt.is_finite() {
+        return bad(Error::NonFinite);
+    }
+    if args.impulse_dt < T::ZERO || matches!(args.grid, Grid::Face(a) if a >= D) {
+        return bad(Error::InvalidArgument);
+    }
+    let reads = Reads {
+        x: true,
+        motion: true,
+        mass: true,
+    };
+    if n > 0 && !ps.has(reads, material) {
+        return bad(Error::InvalidArgument);
+    }
+    let mut op = P2gOp::<T, D> {
+        material,
+        checked: Checked::new(material),
+        args,
+        n,
+        ps,
+        view,
+        first: FirstFailure::new(n),
+    };
+    dispatch::<T, _>(isa, &mut op);
+    op.first.status()
+}
+
+struct P2gOp<'a, T, const D: usize> {
+    material: &'a Material<T>,
+    checked: Checked,
+    args: &'a P2gArgs<T>,
+    n: usize,
+    ps: &'a Particles<T>,
+    view: &'a P2gView<T, D>,
+    first: FirstFailure,
+}
+
+/// What the scalar pass knows about a particle before its stress.
+#[derive(Clone, Copy)]
+struct Pre<T, const D: usize> {
+    p: Particle<T, D>,
+    j_e: T,
+    inv_lambda: T,
+    mu: T,
+}
+
+impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline(always)]
+    unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
+        let reads = Reads {
+            x: true,
+            motion: true,
+            mass: true,
+        };
+        let p = self.ps.get::<D>(i, reads, self.material)?;
+        self.checked.for_phase(p.phase)?;
+        let (j_e, j_p) = check_particle(&p)?;
+        if self.material.heat.is_some() && !p.temperature.is_finite() {
+            return Err(Error::NonFinite);
+        }
+        let m = self.material.moduli(p.phase, j_p)?;
+        Ok(Pre {
+            p,
+            j_e,
+            inv_lambda: m.inv_lambda,
+            mu: m.mu,
+        })
+    }
+
+    /// The node loop inputs of a particle with deviatoric Kirchhoff stress `tau_dev`.
+    #[inline(always)]
+    fn ready(&self, pre: &Pre<T, D>, tau_dev: Mat<T, D>) -> Result<Ready<T, D>> {
+        let p = &pre.p;
+        let a = self.args;
+        let s = Stencil::new(a.kernel, a.grid, a.h, &p.x)?;
+        let mut tau = tau_dev;
+        if self.material.dilation == Dilation::Explicit {
+            let k = dilation::kirchhoff(pre.j_e, pre.inv_lambda)?;
+            for d in 0..D {
+                tau.cols[d][d] += k;
+            }
+        }
+        let fm = tau * (-p.volume0);
+        let mch = p.affine * (p.mass * a.h);
+        let mut q0 = [T::ZERO; D];
+        for r in 0..D {
+            let mut c = T::ZERO;
+            for b in 0..D {
+                c += mch.cols[b][r] * s.fx[b];
+            }
+            q0[r] = p.mass * p.v[r] - c;
+        }
+        let heat = match &self.material.heat {
+            Some(_) => {
+                let pp = self.material.params(p.phase);
+                let mc = p.mass * pp.heat_capacity;
+                [mc, mc * p.temperature, p.mass * pp.conductivity]
+            }
+            None => [T::ZERO; 3],
+        };
+        let mut chk = true;
+        for x in q0.iter().chain(heat.iter()) {
+            taint(&mut chk, *x);
+        }
+        if !(chk && fm.is_finite() && mch.is_finite()) {
+            return Err(Error::Overflow);
+        }
+        Ok(Ready {
+            s,
+            q0,
+            mch,
+            fm,
+            mass: p.mass,
+            heat,
+        })
+    }
+
+    /// Scatter-adds one particle. Every node value is written as it is formed, its old value
+    /// kept; if one is not finite, the old values are put back (in reverse order, so that
+    /// aliased channels are restored too) and the particle fails.
+    #[inline(always)]
+    unsafe fn scatter<const K: usize>(&self, r: &Ready<T, D>) -> Result<()> {
+        let v = self.view;
+        let rel = rel_base(&r.s, &v.nodes)?;
+        let comps: (usize, usize) = match self.args.grid {
+            Grid::Collocated => (0, D),
+            Grid::Face(a) => (a, a + 1),
+        };
+        let heat_on = self.material.heat.is_some() && self.args.grid == Grid::Collocated;
+        // The active channels: (kind, data, offset table).
+        let mut act: [(usize, *mut T, [[isize; 4]; D]); CH] =
+            [(0, ptr::null_mut(), [[0; 4]; D]); CH];
+        let mut na = 0;
+        {
+            let mut add = |kind: usize, ch: &OutChannel<T, D>| {
+                if !ch.data.is_null() {
+                    act[na] = (kind, ch.data, table(ch, &rel));
+                    na += 1;
+                }
+            };
+            add(0, &v.mass);
+            for a in comps.0..comps.1 {
+                add(1 + a, &v.momentum[a]);
+                add(4 + a, &v.force[a]);
+            }
+            if heat_on {
+                add(7, &v.heat_capacity);
+                add(8, &v.thermal_energy);
+                add(9, &v.conductivity);
+            }
+        }
+        let act = &act[..na];
+        let mut old = [core::mem::MaybeUninit::<T>::uninit(); 64 * CH];
+        let mut k = 0;
+        let mut chk = true;
+        let idt = self.args.impulse_dt;
+        let oc: [T; 4] = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
+        let nd = nodes::<T, D, K>(&r.s);
+        for node in 0..nd.n {
+            let (o, w, g) = (nd.o[node], nd.w[node], nd.g[node]);
+            let mut val = [T::ZERO; CH];
+            val[0] = w * r.mass;
+            for a in 0..D {
+                let mut f = T::ZERO;
+                let mut q = r.q0[a];
+                for b in 0..D {
+                    f += r.fm.cols[b][a] * g[b];
+                    q += r.mch.cols[b][a] * oc[o[b]];
+                }
+                val[4 + a] = f;
+                val[1 + a] = w * q + idt * f;
+            }
+            for c in 0..3 {
+                val[7 + c] = w * r.heat[c];
+            }
+            for (kind, data, t) in act {
+                let p = data.offset(off(t, &o));
+                let x = ptr::read_unaligned(p);
+                let nv = x + val[*kind];
+                taint(&mut chk, nv);
+                old[k].write(x);
+                k += 1;
+                ptr::write_unaligned(p, nv);
+            }
+        }
+        if chk {
+            return Ok(());
+        }
+        // Put the old values back, last written first.
+        for node in (0..nd.n).rev() {
+            let o = nd.o[node];
+            for (j, (_, data, t)) in act.iter().enumerate().rev() {
+                // SAFETY: written by the node loop above.
+                let x = old[node * na + j].assume_init();
+                ptr::write_unaligned(data.offset(off(t, &o)), x);
+            }
+        }
+        Err(Error::Overflow)
+    }
+
+    #[inline(always)]
+    unsafe fn finish(&mut self, i: usize, pre: &Pre<T, D>, tau_dev: Mat<T, D>) {
+        let r = self
+            .ready(pre, tau_dev)
+            .and_then(|r| match self.args.kernel {
+                Kernel::Quadratic => self.scatter::<3>(&r),
+                Kernel::Cubic => self.scatter::<4>(&r),
+            });
+        self.first.note(i, r);
+    }
+}
+
+impl<T: BatchReal, const D: usize> LaneOp<T> for P2gOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline(always)]
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        let lanes = V::LANES;
+        let mut start = 0;
+        while start < self.n {
+            let len = lanes.min(self.n - start);
+            let mut pre: [Option<Pre<T, D>>; MAX_LANES] = [None; MAX_LANES];
+            let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
+            let mut mubuf = [T::ZERO; MAX_LANES];
+            let mut any_mu = false;
+            for l in 0..len {
+                // SAFETY: `p2g`'s contract: the arrays hold `n` particles.
+                match unsafe { self.pre(start + l) } {
+                    Ok(pr) => {
+                        for j in 0..D {
+                            for r in 0..D {
+                                fbuf[r + D * j][l] = pr.p.f_e.cols[j][r];
+                            }
+                        }
+                        mubuf[l] = pr.mu;
+                        any_mu |= pr.mu > T::ZERO;
+                        pre[l] = Some(pr);
+                    }
+                    Err(e) => self.first.note(start + l, Err(e)),
+                }
+            }
+            for l in len..lanes {
+                for d in 0..D {
+                    fbuf[d * (D + 1)][l] = T::ONE;
+                }
+            }
+            let mut tbuf = [[T::ZERO; MAX_LANES]; 9];
+            let mut lane_err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            if any_mu {
+                // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
+                let mut f: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
+                for j in 0..D {
+                    for r in 0..D {
+                        f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
+                    }
+                }
+                let (co, ck) = evaluate(V::load(&mubuf[..lanes]), &f);
+                let tau = mul_nt(&ahat(&co), &f);
+                for j in 0..D {
+                    for r in 0..D {
+                        tau[j][r].store(&mut tbuf[r + D * j][..lanes]);
+                    }
+                }
+                let bits = check_bits::<V>(&ck);
+                for (l, e) in lane_err.iter_mut().enumerate().take(len) {
+                    // Lanes with μ = 0 ran no decomposition in the scalar path either.
+                    if mubuf[l] > T::ZERO {
+                        *e = lane_error(&bits, l);
+                    }
+                }
+            }
+            for l in 0..len {
+                if let Some(pr) = pre[l] {
+                    if let Some(e) = lane_err[l] {
+                        self.first.note(start + l, Err(e));
+                        continue;
+                    }
+                    let mut tau = Mat::<T, D>::ZERO;
+                    for j in 0..D {
+                        for r in 0..D {
+                            tau.cols[j][r] = tbuf[r + D * j][l];
+                        }
+                    }
+                    // SAFETY: `p2g`'s contract: valid channels over the box.
+                    unsafe { self.finish(start + l, &pr, tau) };
+                }
+            }
+            start += len;
+        }
+        self.first.status()
+    }
+}

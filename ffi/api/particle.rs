@@ -1,0 +1,250 @@
+//! The MPM particle updates: transfers through grid views, the implicit force differential,
+//! stencils and pressures.
+
+use super::{Module, Op};
+
+pub const MODULE: Module = Module {
+    name: "particle",
+    doc: "The C entry points of the MPM particle updates; the generic bodies are in
+        `crate::particle::imp`, the types and their docs in `crate::particle`.",
+    uses: &[
+        "crate::particle::imp",
+        "crate::particle::{AmpmForceView, AmpmG2pView, AmpmMaterial, AmpmP2gView, AmpmParticles}",
+        "crate::status::AmpmStatus",
+        "core::ffi::{c_int, c_uint}",
+    ],
+    ops: &[
+        Op {
+            name: "p2g",
+            doc: "
+                P2G of n particles ({D}D, {T}) into the host's grid: scatter-adds node mass, APIC momentum,
+                stress force and heat into the channels of `view` (see AmpmP2gView for every formula).
+
+                `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a MAC face axis 0..d − 1; `h` > 0:
+                grid spacing (m); `impulse_dt` ≥ 0 (s): the momentum channels also receive impulse_dt·f_i (0
+                for plain momentum; dt for the symplectic-Euler form m v* + dt f, so the host needs no force
+                channel); `particles`: reads x, v, affine, f_e, f_p, mass, volume0, temperature (THERMAL),
+                phase (if not NULL; required with PHASE_CHANGE), latent (PHASE_CHANGE); writes nothing.
+                Stresses use SIMD lanes of the instruction set of ampm_isa(); results do not depend on a
+                particle's position in the batch.
+
+                Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID if its stencil leaves view->nodes;
+                AMPM_ERR_OVERFLOW if a node value it would write (old value + contribution) is not finite;
+                the particle errors of AmpmParticles and the kernels; a failed particle writes nothing.
+                Whole-call errors (NULL material, particles, view or a particle array the material needs;
+                bad kernel, grid, h, impulse_dt; dims < 0; n too large): nothing written, *first_failed = 0.
+                Threads: concurrent calls are safe when the nodes they write do not overlap.
+
+                `material`: the model and its parameters (AmpmMaterial). `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "material: *const AmpmMaterial<{T}>",
+                "kernel: c_uint",
+                "grid: c_int",
+                "h: {T}",
+                "impulse_dt: {T}",
+                "n: usize",
+                "particles: *const AmpmParticles<{T}>",
+                "view: *const AmpmP2gView<{T}>",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::p2g::<{T}, {D}>(material, kernel, grid, h, impulse_dt, n, particles, view, first_failed)",
+        },
+        Op {
+            name: "g2p_update",
+            doc: "
+                G2P and particle update of n particles ({D}D, {T}) from the host's collocated grid.
+
+                Per particle: v_p = Σ w_i v_i, C_p = Σ w_i v_i (x_i − x_p)ᵀ / (κ h²) (κ = 1/4 quadratic, 1/3
+                cubic), ∇v_p = Σ v_i ∇w_iᵀ; with THERMAL T* = (1 − α) Σ w_i T_i^(n+1) + α (T_p + Σ w_i (T_i^(n+1) −
+                T_i^n)), and with PHASE_CHANGE the heat c (T* − T_p) goes through the latent buffer and may
+                switch the phase; x_p += dt v_p; F_E ← (I + dt ∇v_p) F_E, replaced by (I + 2^-k dt ∇v_p)^(2^k)
+                with the smallest k ≥ 1 (at most 64) giving det > 0 when det(I + dt ∇v_p) ≤ 0; then a liquid
+                sets F_E = J_E^(1/d) I, F_P = J_P^(1/d) I, and a plastic solid clamps the singular values of
+                F_E.
+
+                `kernel`: AMPM_KERNEL_*; `h` > 0 (m); `dt` > 0 (s); `view`: velocities (required) and, with
+                THERMAL, temperatures (required). Reads and writes x, v, affine, f_e, f_p; temperature
+                (THERMAL); latent and phase (PHASE_CHANGE); reads mass, volume0.
+
+                Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID; AMPM_ERR_NON_FINITE for a non-finite
+                node value it reads; AMPM_ERR_OVERFLOW for a result that is not representable (including
+                1/(κ h²)); AMPM_ERR_NON_POSITIVE_J when the update would leave det F_E or det F_P not positive;
+                a failed particle keeps its state, and every particle updated with success is accepted by the
+                next call. Whole-call errors (NULL pointers the call needs, bad kernel, h, dt): nothing
+                written, *first_failed = 0. Threads: concurrent calls on disjoint particles are safe.
+
+                `material`: the model and its parameters (AmpmMaterial). `n`: number of particles. `particles`: the particle arrays (AmpmParticles). `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "material: *const AmpmMaterial<{T}>",
+                "kernel: c_uint",
+                "h: {T}",
+                "dt: {T}",
+                "n: usize",
+                "particles: *const AmpmParticles<{T}>",
+                "view: *const AmpmG2pView<{T}>",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::g2p_update::<{T}, {D}>(material, kernel, h, dt, n, particles, view, core::ptr::null(), false, first_failed)",
+        },
+        Op {
+            name: "g2p_update_mac",
+            doc: "
+                G2P and particle update of n particles ({D}D, {T}) from a MAC grid: as ampm_g2p_update_{D}d_{T},
+                but velocity component a, row a of C_p and row a of ∇v_p come from face grid a with its own
+                stencil: `faces` points to {D} views, faces[a] covering face grid a (nodes at i·h along a,
+                (j + 1/2)·h along the other axes) with faces[a].velocity[a] required (the other channels of
+                faces[a] are not read). `thermal`: the collocated view of the temperatures, required with
+                THERMAL (its velocities are not read), else may be NULL.
+
+                `material`: the model and its parameters (AmpmMaterial). `kernel`: as documented above. `h`: as documented above. `dt`: as documented above. `n`: number of particles. `particles`: the particle arrays (AmpmParticles). `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "material: *const AmpmMaterial<{T}>",
+                "kernel: c_uint",
+                "h: {T}",
+                "dt: {T}",
+                "n: usize",
+                "particles: *const AmpmParticles<{T}>",
+                "faces: *const AmpmG2pView<{T}>",
+                "thermal: *const AmpmG2pView<{T}>",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::g2p_update::<{T}, {D}>(material, kernel, h, dt, n, particles, thermal, faces, true, first_failed)",
+        },
+        Op {
+            name: "node_range",
+            doc: "
+                The box of grid nodes that the stencils of n ≥ 1 particles ({D}D, {T}) reach: writes lo[a]
+                and hi[a] (a < {D}, inclusive) so that a view with nodes.lo = lo, nodes.dims = hi − lo + 1
+                covers them. `x`: n·{D} positions (m); `kernel`, `grid`, `h` as ampm_p2g_{D}d_{T}.
+
+                A host running P2G on several threads sorts its particles by cell, calls this per particle
+                range, and gives each thread a view of its own block (then adds the overlapping borders), or
+                runs blocks at least K cells apart at the same time. On a particle error nothing is written
+                and its index goes to *first_failed; n = 0 or NULL pointers are whole-call errors.
+
+                `n`: number of particles. `lo`: {D} grid indices (output). `hi`: {D} grid indices (output). `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "kernel: c_uint",
+                "grid: c_int",
+                "h: {T}",
+                "n: usize",
+                "x: *const {T}",
+                "lo: *mut i32",
+                "hi: *mut i32",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::node_range::<{T}, {D}>(kernel, grid, h, n, x, lo, hi, first_failed)",
+        },
+        Op {
+            name: "force_prepare",
+            doc: "
+                Prepares the implicit force differential of n particles ({D}D, {T}), once per Newton step:
+                writes n·AMPM_FORCE_SLOT_LEN_{D}D scalars to `slots` (opaque). Reads f_e, f_p, volume0, phase
+                (and latent with PHASE_CHANGE); positions are not read. Uses the exact Hessian, or with
+                AMPM_MODEL_PSD_HESSIAN its projection onto the negative semi-definite part of the whole force
+                differential (dilational part included). Stiffness terms use SIMD lanes of ampm_isa().
+
+                A failed particle's slot is marked (its first scalar set to 0) so that ampm_force_apply_*
+                refuses it with AMPM_ERR_NOT_PREPARED; zero-filled memory is refused the same way.
+                Whole-call errors: nothing written, *first_failed = 0.
+
+                `material`: the model and its parameters (AmpmMaterial). `n`: number of particles. `particles`: the particle arrays (AmpmParticles). `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "material: *const AmpmMaterial<{T}>",
+                "n: usize",
+                "particles: *const AmpmParticles<{T}>",
+                "slots: *mut {T}",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::force_prepare::<{T}, {D}>(material, n, particles, slots, first_failed)",
+        },
+        Op {
+            name: "force_apply",
+            doc: "
+                Applies the prepared force differential of n particles ({D}D, {T}), once per Krylov iteration:
+                df_i += Σ_p M_p ∇w_ip with M_p = 𝒜_p(Σ_j du_j ∇w_jpᵀ): the linearisation, for node
+                displacements du (m), of the grid force of Stomakhin et al. 2013 (eq. 6),
+                f_i(x̂) = −Σ_p V0_p P(F̂_p) F_E,pᵀ ∇w_ip with F̂_p = (I + Σ_j (x̂_j − x_j) ∇w_jpᵀ) F_E,p and
+                F_E,p, ∇w held at the prepared state. That is df = K du with the stiffness K = ∂f/∂x̂ (the
+                negative Hessian of the elastic energy): symmetric, and negative semi-definite with
+                AMPM_MODEL_PSD_HESSIAN.
+
+                `x`: the n·{D} particle positions (m) of the Newton step (the stencils); `kernel`, `h` as
+                ampm_p2g_{D}d_{T} (collocated grid); `slots` from ampm_force_prepare_{D}d_{T}; `view`: du and df
+                channels, all required; the host zeroes df first.
+
+                Backward Euler (Stomakhin et al. 2013, §4.2): with grid masses m_i, velocities v* = v^n +
+                dt f^n/m and x̂ = x + dt v, solve (M − dt² K) v^(n+1) = M v*, i.e. for each CG iteration the
+                operator is (A v)_i = m_i v_i − dt·df_i with df = apply(du = dt·v). With the PSD option
+                A is symmetric positive definite wherever m_i > 0. Per particle (batch contract):
+                AMPM_ERR_NOT_PREPARED, AMPM_ERR_OUTSIDE_GRID, AMPM_ERR_NON_FINITE for a non-finite du read,
+                AMPM_ERR_OVERFLOW for a df that would not be finite; a failed particle writes nothing.
+
+                `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "kernel: c_uint",
+                "h: {T}",
+                "n: usize",
+                "x: *const {T}",
+                "slots: *const {T}",
+                "view: *const AmpmForceView<{T}>",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::force_apply::<{T}, {D}>(kernel, h, n, x, slots, view, first_failed)",
+        },
+        Op {
+            name: "stencil",
+            doc: "
+                Stencils of n particles ({D}D, {T}): B-spline weights and weight gradients, for host-side
+                transfers of its own fields. `kernel`: AMPM_KERNEL_*; `grid`: AMPM_GRID_COLLOCATED or a face
+                axis 0..d − 1; `h` > 0 (m); `x`: n·{D} positions (m). Writes `base` (n·{D} grid indices of each
+                stencil's first node), `weight` (n·K^d) and, if not NULL, `grad_weight` (n·K^d·{D}, 1/m), with
+                K^d = 3^d (quadratic) or 4^d (cubic). Node order: node r of a stencil has offsets
+                o_a = (r / K^a) mod K (axis 0 fastest) and grid index base + o; weight of node r of particle p
+                at [K^d·p + r], its gradient component a at [(K^d·p + r)·{D} + a]. Batch contract.
+
+                `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "kernel: c_uint",
+                "grid: c_int",
+                "h: {T}",
+                "n: usize",
+                "x: *const {T}",
+                "base: *mut c_int",
+                "weight: *mut {T}",
+                "grad_weight: *mut {T}",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::stencil::<{T}, {D}>(kernel, grid, h, n, x, base, weight, grad_weight, first_failed)",
+        },
+        Op {
+            name: "pressure",
+            doc: "
+                Particle pressures and pressure-solve coefficients of n particles ({D}D, {T}) for a host's
+                Chorin pressure solve (Stomakhin et al. 2014, §5): `pressure` (n, Pa, may be NULL) gets
+                p = −λ (J_E − 1)/J_P (needs 1/λ > 0); `coefficient` (n, 1/(Pa·s), may be NULL) gets
+                J_P/(dt λ J_E), 0 for an incompressible particle, with the hardened λ of a plastic solid.
+                Reads f_e, f_p, volume0, phase (and latent with PHASE_CHANGE). Batch contract.
+
+                `material`: the model and its parameters (AmpmMaterial). `dt`: as documented above. `n`: number of particles. `particles`: the particle arrays (AmpmParticles). `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).",
+            params: &[
+                "material: *const AmpmMaterial<{T}>",
+                "dt: {T}",
+                "n: usize",
+                "particles: *const AmpmParticles<{T}>",
+                "pressure: *mut {T}",
+                "coefficient: *mut {T}",
+                "first_failed: *mut usize",
+            ],
+            ret: "AmpmStatus",
+            body: "imp::pressure::<{T}, {D}>(material, dt, n, particles, pressure, coefficient, first_failed)",
+        },
+    ],
+};

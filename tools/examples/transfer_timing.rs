@@ -1,0 +1,136 @@
+//! Quick split timing of P2G and G2P (3D f32 quadratic): `cargo run --release -p ampm-tools
+//! --example transfer_timing -- <fluid|elastic>` (a development aid; the benchmark is
+//! `tools/benches/particle_levels.rs`).
+use ampm_core::lane::Isa;
+use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
+use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
+use ampm_core::particle::transfer::{Channel, NodeBox, Particles};
+use ampm_core::particle::{Grid, Kernel, Material, Phase, PhaseParams};
+use std::time::Instant;
+
+fn main() {
+    const D: usize = 3;
+    let level = std::env::args().nth(1).unwrap_or_else(|| "elastic".into());
+    let liquid = level == "fluid";
+    let s = 38usize;
+    let n = s * s * s;
+    let h = 0.02f32;
+    let mut x = Vec::new();
+    for i in 0..n {
+        let mut q = i;
+        for _ in 0..D {
+            x.push((4.0 + ((q % s) as f32 + 0.5) * 0.5) * h);
+            q /= s;
+        }
+    }
+    let mut v = vec![0.01f32; n * D];
+    let mut affine = vec![0.0f32; n * 9];
+    let mut f_e = vec![0.0f32; n * 9];
+    let mut f_p = vec![0.0f32; n * 9];
+    for i in 0..n {
+        for d in 0..D {
+            f_e[9 * i + 4 * d] = if liquid { 1.0 } else { 1.0 + 0.01 * (d as f32) };
+            f_p[9 * i + 4 * d] = 1.0;
+        }
+        if !liquid {
+            f_e[9 * i + 1] = 0.02;
+        }
+    }
+    let mass = vec![1e-3f32; n];
+    let vol = vec![1e-6f32; n];
+    let mut t = vec![0.0f32; n];
+    let mut u = vec![0.0f32; n];
+    let mut ph = vec![if liquid { Phase::Liquid } else { Phase::Solid } as u8; n];
+    let ps = Particles {
+        x: x.as_mut_ptr(),
+        v: v.as_mut_ptr(),
+        affine: affine.as_mut_ptr(),
+        f_e: f_e.as_mut_ptr(),
+        f_p: f_p.as_mut_ptr(),
+        mass: mass.as_ptr(),
+        volume0: vol.as_ptr(),
+        temperature: t.as_mut_ptr(),
+        latent: u.as_mut_ptr(),
+        phase: ph.as_mut_ptr(),
+    };
+    let p = PhaseParams {
+        mu: 1e5,
+        inv_lambda: 1e-5,
+        heat_capacity: 1.0,
+        conductivity: 1.0,
+    };
+    let mat = Material {
+        solid: p,
+        liquid: PhaseParams { mu: 0.0, ..p },
+        ..Material::default()
+    };
+    let dims = [(s / 2 + 8) as i32; D];
+    let nn: usize = dims.iter().map(|&d| d as usize).product();
+    let stride = [1, dims[0] as isize, (dims[0] * dims[1]) as isize];
+    let mut grid = vec![vec![0.0f32; nn]; 4];
+    let nodes = NodeBox { lo: [0; D], dims };
+    for isa in Isa::available() {
+        let args = P2gArgs {
+            kernel: Kernel::Quadratic,
+            grid: Grid::Collocated,
+            h,
+            impulse_dt: 1e-4,
+        };
+        let reps = 10;
+        let mut best = (f64::MAX, f64::MAX);
+        for _ in 0..reps {
+            for c in grid.iter_mut() {
+                c.iter_mut().for_each(|x| *x = 0.0);
+            }
+            let view = P2gView {
+                nodes,
+                mass: Channel {
+                    data: grid[0].as_mut_ptr(),
+                    stride,
+                },
+                momentum: [1, 2, 3].map(|c| Channel {
+                    data: grid[c].as_mut_ptr(),
+                    stride,
+                }),
+                force: [Channel::<*mut f32, D>::none(); D],
+                heat_capacity: Channel::<*mut f32, D>::none(),
+                thermal_energy: Channel::<*mut f32, D>::none(),
+                conductivity: Channel::<*mut f32, D>::none(),
+            };
+            let t0 = Instant::now();
+            // SAFETY: n particles, channels cover the box.
+            let st = unsafe { p2g::p2g(isa, &mat, &args, n, &ps, &view) };
+            let t1 = t0.elapsed().as_secs_f64();
+            assert_eq!(st.error, None);
+            for c in 1..4 {
+                grid[c].iter_mut().for_each(|x| *x = 1e-3);
+            }
+            let gv = G2pView {
+                nodes,
+                velocity: [1, 2, 3].map(|c| Channel {
+                    data: grid[c].as_ptr(),
+                    stride,
+                }),
+                temperature: Channel::<*const f32, D>::none(),
+                temperature_old: Channel::<*const f32, D>::none(),
+            };
+            let gargs = G2pArgs {
+                kernel: Kernel::Quadratic,
+                h,
+                dt: 1e-4,
+            };
+            let t0 = Instant::now();
+            // SAFETY: as above.
+            let st = unsafe { g2p::g2p_update(&mat, &gargs, n, &ps, &gv, None) };
+            let t2 = t0.elapsed().as_secs_f64();
+            assert_eq!(st.error, None);
+            best = (best.0.min(t1), best.1.min(t2));
+        }
+        println!(
+            "{level} {}: p2g {:.1} ns, g2p {:.1} ns per particle (best of {reps})",
+            isa.name(),
+            best.0 / n as f64 * 1e9,
+            best.1 / n as f64 * 1e9
+        );
+    }
+}
