@@ -9,7 +9,7 @@ use super::{
     AMPM_KERNEL_CUBIC, AMPM_KERNEL_QUADRATIC, AMPM_MODEL_PHASE_CHANGE, AMPM_MODEL_PLASTIC,
     AMPM_MODEL_PRESSURE_SOLVE, AMPM_MODEL_PSD_HESSIAN, AMPM_MODEL_THERMAL,
 };
-use crate::abi::guard;
+use crate::abi::batch_call;
 use crate::fast::isa;
 use crate::status::AmpmStatus;
 use ampm_core::kernel::batch::{BatchReal, BatchStatus};
@@ -17,7 +17,7 @@ use ampm_core::kernel::{Dim, LaneDim};
 use ampm_core::particle::transfer::force::{self, ForceView};
 use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
-use ampm_core::particle::transfer::{Channel, NodeBox, Particles, Reads};
+use ampm_core::particle::transfer::{self, Channel, FirstFailure, NodeBox, Particles, Reads};
 use ampm_core::particle::{
     update, Definiteness, Dilation, Grid, Heat, Kernel, Material, Particle, PhaseParams, Snow,
     Stencil,
@@ -30,36 +30,13 @@ use core::ptr;
 /// `Err(status)` returns at once.
 type Call<T> = Result<T, AmpmStatus>;
 
-/// Writes `*first_failed` (if non-null) and returns the status.
-unsafe fn finish(s: BatchStatus, first_failed: *mut usize) -> AmpmStatus {
-    if !first_failed.is_null() {
-        *first_failed = s.first_failed;
-    }
-    match s.error {
+/// The status and first failed index of a core batch, for [`batch_call`].
+fn done(s: BatchStatus) -> (AmpmStatus, usize) {
+    let st = match s.error {
         None => AmpmStatus::AMPM_OK,
         Some(e) => e.into(),
-    }
-}
-
-/// A whole-call error: nothing written, `*first_failed = 0`.
-unsafe fn whole(st: AmpmStatus, first_failed: *mut usize) -> AmpmStatus {
-    if !first_failed.is_null() {
-        *first_failed = 0;
-    }
-    st
-}
-
-/// Runs `body`; a whole-call error from it is reported as [`whole`].
-unsafe fn call(first_failed: *mut usize, body: impl FnOnce() -> Call<AmpmStatus>) -> AmpmStatus {
-    let st = guard(|| match body() {
-        Ok(s) => s,
-        Err(s) => whole(s, first_failed),
-    });
-    if st == AmpmStatus::AMPM_ERR_INTERNAL {
-        whole(st, first_failed)
-    } else {
-        st
-    }
+    };
+    (st, s.first_failed)
 }
 
 fn kernel_of(k: c_uint) -> Call<Kernel> {
@@ -238,7 +215,7 @@ where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let mat = material_of(material)?;
         let ps = particles_of(n, particles, Reads::ALL, &mat, D)?;
         let v = read(view)?;
@@ -258,10 +235,7 @@ where
             thermal_energy: out(&v.thermal_energy),
             conductivity: out(&v.conductivity),
         };
-        Ok(finish(
-            p2g::p2g(isa(), &mat, &args, n, &ps, &view),
-            first_failed,
-        ))
+        Ok(done(p2g::p2g(isa(), &mat, &args, n, &ps, &view)))
     })
 }
 
@@ -291,7 +265,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let mat = material_of(material)?;
         let ps = particles_of(n, particles, Reads::ALL, &mat, D)?;
         let args = G2pArgs {
@@ -353,10 +327,14 @@ where
             }
             None
         };
-        Ok(finish(
-            g2p::g2p_update(&mat, &args, n, &ps, &cview, fv.as_ref()),
-            first_failed,
-        ))
+        Ok(done(g2p::g2p_update(
+            &mat,
+            &args,
+            n,
+            &ps,
+            &cview,
+            fv.as_ref(),
+        )))
     })
 }
 
@@ -371,7 +349,7 @@ pub(crate) unsafe fn node_range<T: Real, const D: usize>(
     hi: *mut i32,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let kernel = kernel_of(kernel)?;
         let grid = grid_of::<D>(grid)?;
         if x.is_null() || lo.is_null() || hi.is_null() {
@@ -381,33 +359,18 @@ pub(crate) unsafe fn node_range<T: Real, const D: usize>(
             return Err(AmpmStatus::AMPM_ERR_INVALID_ARGUMENT);
         }
         check_size::<T>(n, D)?;
-        let k = kernel.width() as i32;
-        let (mut l, mut u) = ([i32::MAX; D], [i32::MIN; D]);
-        for i in 0..n {
-            let xp: [T; D] = core::array::from_fn(|a| ptr::read_unaligned(x.add(D * i + a)));
-            match Stencil::new(kernel, grid, h, &xp) {
-                Ok(s) => {
-                    for a in 0..D {
-                        l[a] = l[a].min(s.base[a]);
-                        u[a] = u[a].max(s.base[a] + k - 1);
-                    }
+        // `[T; D]` has the layout of D consecutive scalars.
+        let xs = core::slice::from_raw_parts(x.cast::<[T; D]>(), n);
+        match transfer::node_range(kernel, grid, h, xs) {
+            Ok((l, u)) => {
+                for a in 0..D {
+                    ptr::write_unaligned(lo.add(a), l[a]);
+                    ptr::write_unaligned(hi.add(a), u[a]);
                 }
-                Err(e) => {
-                    if !first_failed.is_null() {
-                        *first_failed = i;
-                    }
-                    return Ok(e.into());
-                }
+                Ok((AmpmStatus::AMPM_OK, n))
             }
+            Err((i, e)) => Ok((e.into(), i)),
         }
-        for a in 0..D {
-            ptr::write_unaligned(lo.add(a), l[a]);
-            ptr::write_unaligned(hi.add(a), u[a]);
-        }
-        if !first_failed.is_null() {
-            *first_failed = n;
-        }
-        Ok(AmpmStatus::AMPM_OK)
     })
 }
 
@@ -423,17 +386,14 @@ where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let mat = material_of(material)?;
         let ps = particles_of(n, particles, Reads::DEFORMATION, &mat, D)?;
         check_size::<T>(n, ampm_core::particle::implicit::slot_len(D))?;
         if n > 0 && slots.is_null() {
             return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
-        Ok(finish(
-            force::prepare::<T, D>(isa(), &mat, n, &ps, slots),
-            first_failed,
-        ))
+        Ok(done(force::prepare::<T, D>(isa(), &mat, n, &ps, slots)))
     })
 }
 
@@ -450,7 +410,7 @@ pub(crate) unsafe fn force_apply<T: Real, const D: usize>(
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let kernel = kernel_of(kernel)?;
         finite_h(h)?;
         let v = read(view)?;
@@ -466,34 +426,17 @@ where
         if missing {
             return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
-        Ok(finish(
-            force::apply::<T, D>(kernel, h, n, x, slots, &fv),
-            first_failed,
-        ))
+        Ok(done(force::apply::<T, D>(kernel, h, n, x, slots, &fv)))
     })
 }
 
-/// Runs `k` for every particle under the batch contract.
-unsafe fn run(
-    n: usize,
-    first_failed: *mut usize,
-    mut k: impl FnMut(usize) -> Result<(), Error>,
-) -> AmpmStatus {
-    let mut first = (n, None);
+/// Runs `k` for every particle under the batch contract: the first failure and its index.
+fn run(n: usize, mut k: impl FnMut(usize) -> Result<(), Error>) -> (AmpmStatus, usize) {
+    let mut first = FirstFailure::new(n);
     for i in 0..n {
-        if let Err(e) = k(i) {
-            if first.1.is_none() {
-                first = (i, Some(e));
-            }
-        }
+        first.note(i, k(i));
     }
-    finish(
-        BatchStatus {
-            first_failed: first.0,
-            error: first.1,
-        },
-        first_failed,
-    )
+    done(first.status())
 }
 
 #[inline]
@@ -513,7 +456,7 @@ pub(crate) unsafe fn stencil<T: Real, const D: usize>(
     grad_weight: *mut T,
     first_failed: *mut usize,
 ) -> AmpmStatus {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let kernel = kernel_of(kernel)?;
         let grid = grid_of::<D>(grid)?;
         let k = kernel.node_count(D);
@@ -521,7 +464,7 @@ pub(crate) unsafe fn stencil<T: Real, const D: usize>(
             return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
         check_size::<T>(n, k * D)?;
-        Ok(run(n, first_failed, |i| {
+        Ok(run(n, |i| {
             let s = Stencil::<T, D>::new(kernel, grid, h, &rd_vec(x, i))?;
             for a in 0..D {
                 ptr::write_unaligned(base.add(D * i + a), s.base[a]);
@@ -553,10 +496,10 @@ pub(crate) unsafe fn pressure<T: Real, const D: usize>(
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    call(first_failed, || {
+    batch_call(first_failed, || {
         let mat = material_of(material)?;
         let ps = particles_of(n, particles, Reads::DEFORMATION, &mat, D)?;
-        Ok(run(n, first_failed, |i| {
+        Ok(run(n, |i| {
             let p: Particle<T, D> = ps.get(i, Reads::DEFORMATION, &mat)?;
             let pr = if pressure.is_null() {
                 T::ZERO

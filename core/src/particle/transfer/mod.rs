@@ -328,24 +328,27 @@ impl Checked {
     }
 }
 
-/// Tracks the first failure of a batch.
+/// Tracks the first failure of a batch (the [`BatchStatus`] of a loop over particles).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct FirstFailure {
+pub struct FirstFailure {
     n: usize,
     at: usize,
     err: Option<Error>,
 }
 
 impl FirstFailure {
-    pub(crate) fn new(n: usize) -> Self {
+    /// No failure yet among `n` particles.
+    #[must_use]
+    pub fn new(n: usize) -> Self {
         Self {
             n,
             at: n,
             err: None,
         }
     }
+    /// Records the result of particle `i` (kept only if it is the first failure).
     #[inline(always)]
-    pub(crate) fn note(&mut self, i: usize, r: Result<()>) {
+    pub fn note(&mut self, i: usize, r: Result<()>) {
         if let Err(e) = r {
             if self.err.is_none() {
                 self.at = i;
@@ -353,7 +356,9 @@ impl FirstFailure {
             }
         }
     }
-    pub(crate) fn status(self) -> BatchStatus {
+    /// The first failure and its index (`n` when none).
+    #[must_use]
+    pub fn status(self) -> BatchStatus {
         BatchStatus {
             first_failed: if self.err.is_some() { self.at } else { self.n },
             error: self.err,
