@@ -719,80 +719,84 @@ where
     let (cells, hf) = (12, 0.05);
     let h = T::from_f64(hf);
     let dt = T::from_f64(1e-3);
-    for (name, mat) in materials::<T>() {
-        for kernel in [Kernel::Quadratic, Kernel::Cubic] {
-            let mut rng = Pcg64::seed_from_u64(5);
-            let ps = particles::<T, D>(&mut rng, 60, hf, cells, &mat);
-            let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
-            let mut r2 = Pcg64::seed_from_u64(9);
-            let n = g.ch[0].len();
-            for k in 0..n {
-                for a in 0..D {
-                    g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
-                }
-                g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-                g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-            }
-            let mut store = Store::from(&ps);
-            let args = G2pArgs { kernel, h, dt };
-            let raw = store.raw();
-            // SAFETY: as above.
-            let st = unsafe { g2p::g2p_update(&mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
-            for (i, p) in ps.iter().enumerate() {
-                let s = Stencil::new(kernel, Grid::Collocated, h, &p.x).unwrap();
-                let vel: Vec<[T; D]> = s
-                    .nodes()
-                    .map(|nd| std::array::from_fn(|a| g.ch[MOM + a][g.index(nd.index)]))
-                    .collect();
-                let tn: Vec<T> = s.nodes().map(|nd| g.ch[HC][g.index(nd.index)]).collect();
-                let to: Vec<T> = s
-                    .nodes()
-                    .map(|nd| g.ch[HC + 1][g.index(nd.index)])
-                    .collect();
-                let sample = GridSample {
-                    velocity: &vel,
-                    temperature: Some((&tn, &to)),
-                };
-                let want = g2p_update(&mat, kernel, h, dt, &sample, p);
-                let got = store.get::<D>(i);
-                match want {
-                    Err(e) => {
-                        assert_eq!(got, *p, "{name}: a failed particle keeps its state");
-                        assert!(st.error.is_some(), "{name} particle {i}: {e:?}");
+    for isa in Isa::available() {
+        for (name, mat) in materials::<T>() {
+            for kernel in [Kernel::Quadratic, Kernel::Cubic] {
+                let mut rng = Pcg64::seed_from_u64(5);
+                let ps = particles::<T, D>(&mut rng, 60, hf, cells, &mat);
+                let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
+                let mut r2 = Pcg64::seed_from_u64(9);
+                let n = g.ch[0].len();
+                for k in 0..n {
+                    for a in 0..D {
+                        g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
                     }
-                    Ok((w, _)) => {
-                        // The affine matrix is formed as (Σ w v oᵀ − v fxᵀ)/(κh) instead of
-                        // Σ w v (x_i − x_p)ᵀ/(κh²): a few roundings of its terms' scale
-                        // (|v|·K/(κh)); everything else is formed in the same order.
-                        let eps = T::EPSILON.to_f64();
-                        let vmax = 1.0;
-                        let kk = kernel.width() as f64;
-                        let ascale = vmax * kk / (kernel.apic_moment::<f64>() * hf);
-                        for j in 0..D {
-                            for r in 0..D {
-                                let (a, b) = (got.affine.cols[j][r], w.affine.cols[j][r]);
-                                assert!(
-                                    (a - b).to_f64().abs() <= 32.0 * eps * ascale,
-                                    "{name} {kernel:?} C[{r}][{j}]: {a:?} vs {b:?}"
-                                );
+                    g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+                    g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+                }
+                let mut store = Store::from(&ps);
+                let args = G2pArgs { kernel, h, dt };
+                let raw = store.raw();
+                // SAFETY: as above.
+                let st = unsafe {
+                    g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None)
+                };
+                for (i, p) in ps.iter().enumerate() {
+                    let s = Stencil::new(kernel, Grid::Collocated, h, &p.x).unwrap();
+                    let vel: Vec<[T; D]> = s
+                        .nodes()
+                        .map(|nd| std::array::from_fn(|a| g.ch[MOM + a][g.index(nd.index)]))
+                        .collect();
+                    let tn: Vec<T> = s.nodes().map(|nd| g.ch[HC][g.index(nd.index)]).collect();
+                    let to: Vec<T> = s
+                        .nodes()
+                        .map(|nd| g.ch[HC + 1][g.index(nd.index)])
+                        .collect();
+                    let sample = GridSample {
+                        velocity: &vel,
+                        temperature: Some((&tn, &to)),
+                    };
+                    let want = g2p_update(&mat, kernel, h, dt, &sample, p);
+                    let got = store.get::<D>(i);
+                    match want {
+                        Err(e) => {
+                            assert_eq!(got, *p, "{name}: a failed particle keeps its state");
+                            assert!(st.error.is_some(), "{name} particle {i}: {e:?}");
+                        }
+                        Ok((w, _)) => {
+                            // The affine matrix is formed as (Σ w v oᵀ − v fxᵀ)/(κh) instead of
+                            // Σ w v (x_i − x_p)ᵀ/(κh²): a few roundings of its terms' scale
+                            // (|v|·K/(κh)); everything else is formed in the same order.
+                            let eps = T::EPSILON.to_f64();
+                            let vmax = 1.0;
+                            let kk = kernel.width() as f64;
+                            let ascale = vmax * kk / (kernel.apic_moment::<f64>() * hf);
+                            for j in 0..D {
+                                for r in 0..D {
+                                    let (a, b) = (got.affine.cols[j][r], w.affine.cols[j][r]);
+                                    assert!(
+                                        (a - b).to_f64().abs() <= 32.0 * eps * ascale,
+                                        "{name} {kernel:?} C[{r}][{j}]: {a:?} vs {b:?}"
+                                    );
+                                }
                             }
-                        }
-                        let close = |a: T, b: T, scale: f64| {
-                            (a - b).to_f64().abs() <= 64.0 * eps * scale.max(b.to_f64().abs())
-                        };
-                        for a in 0..D {
-                            assert!(close(got.x[a], w.x[a], 1.0), "{name} x");
-                            assert!(close(got.v[a], w.v[a], vmax), "{name} v");
-                        }
-                        for j in 0..D {
-                            for r in 0..D {
-                                assert!(close(got.f_e.cols[j][r], w.f_e.cols[j][r], 2.0));
-                                assert!(close(got.f_p.cols[j][r], w.f_p.cols[j][r], 2.0));
+                            let close = |a: T, b: T, scale: f64| {
+                                (a - b).to_f64().abs() <= 64.0 * eps * scale.max(b.to_f64().abs())
+                            };
+                            for a in 0..D {
+                                assert!(close(got.x[a], w.x[a], 1.0), "{name} x");
+                                assert!(close(got.v[a], w.v[a], vmax), "{name} v");
                             }
+                            for j in 0..D {
+                                for r in 0..D {
+                                    assert!(close(got.f_e.cols[j][r], w.f_e.cols[j][r], 2.0));
+                                    assert!(close(got.f_p.cols[j][r], w.f_p.cols[j][r], 2.0));
+                                }
+                            }
+                            assert!(close(got.temperature, w.temperature, TM), "{name} T");
+                            assert!(close(got.latent, w.latent, LATENT), "{name} U");
+                            assert_eq!(got.phase, w.phase, "{name} phase");
                         }
-                        assert!(close(got.temperature, w.temperature, TM), "{name} T");
-                        assert!(close(got.latent, w.latent, LATENT), "{name} U");
-                        assert_eq!(got.phase, w.phase, "{name} phase");
                     }
                 }
             }
@@ -835,53 +839,56 @@ where
         std::array::from_fn(|a| v0[a] + ax[a])
     };
     let mat = materials::<f64>()[0].1;
-    for kernel in [Kernel::Quadratic, Kernel::Cubic] {
-        for mac in [false, true] {
-            let ps = particles::<f64, D>(&mut rng, 30, hf, cells, &mat);
-            let mut store = Store::from(&ps);
-            let mut col = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
-            fill(&mut col, Grid::Collocated, hf, field, |_| (0.0, 0.0));
-            let faces: [DenseGrid<f64, D>; D] = std::array::from_fn(|a| {
-                let mut g = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
-                fill(&mut g, Grid::Face(a), hf, field, |_| (0.0, 0.0));
-                g
-            });
-            let fviews: [G2pView<f64, D>; D] = std::array::from_fn(|a| faces[a].g2p_view());
-            let args = G2pArgs { kernel, h: hf, dt };
-            let raw = store.raw();
-            // SAFETY: as above.
-            let st = unsafe {
-                g2p::g2p_update(
-                    &mat,
-                    &args,
-                    ps.len(),
-                    &raw,
-                    &col.g2p_view(),
-                    mac.then_some(&fviews),
-                )
-            };
-            assert_eq!(st.error, None);
-            let scale = 2.0 * (cells as f64) * hf + 1.0;
-            let tol = 64.0 * f64::EPSILON * scale * 8.0;
-            for (i, p) in ps.iter().enumerate() {
-                let q = store.get::<D>(i);
-                let v = field(p.x);
-                for a in 0..D {
-                    assert!((q.v[a] - v[a]).abs() <= tol, "{kernel:?} mac {mac}: v");
-                    assert!((q.x[a] - (p.x[a] + dt * q.v[a])).abs() <= 4.0 * f64::EPSILON);
-                    for b in 0..D {
-                        assert!(
-                            (q.affine.cols[b][a] - a_m.cols[b][a]).abs() <= tol / hf,
-                            "{kernel:?} mac {mac}: C[{a}][{b}] {} vs {}",
-                            q.affine.cols[b][a],
-                            a_m.cols[b][a]
-                        );
+    for isa in Isa::available() {
+        for kernel in [Kernel::Quadratic, Kernel::Cubic] {
+            for mac in [false, true] {
+                let ps = particles::<f64, D>(&mut rng, 30, hf, cells, &mat);
+                let mut store = Store::from(&ps);
+                let mut col = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
+                fill(&mut col, Grid::Collocated, hf, field, |_| (0.0, 0.0));
+                let faces: [DenseGrid<f64, D>; D] = std::array::from_fn(|a| {
+                    let mut g = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
+                    fill(&mut g, Grid::Face(a), hf, field, |_| (0.0, 0.0));
+                    g
+                });
+                let fviews: [G2pView<f64, D>; D] = std::array::from_fn(|a| faces[a].g2p_view());
+                let args = G2pArgs { kernel, h: hf, dt };
+                let raw = store.raw();
+                // SAFETY: as above.
+                let st = unsafe {
+                    g2p::g2p_update(
+                        isa,
+                        &mat,
+                        &args,
+                        ps.len(),
+                        &raw,
+                        &col.g2p_view(),
+                        mac.then_some(&fviews),
+                    )
+                };
+                assert_eq!(st.error, None);
+                let scale = 2.0 * (cells as f64) * hf + 1.0;
+                let tol = 64.0 * f64::EPSILON * scale * 8.0;
+                for (i, p) in ps.iter().enumerate() {
+                    let q = store.get::<D>(i);
+                    let v = field(p.x);
+                    for a in 0..D {
+                        assert!((q.v[a] - v[a]).abs() <= tol, "{kernel:?} mac {mac}: v");
+                        assert!((q.x[a] - (p.x[a] + dt * q.v[a])).abs() <= 4.0 * f64::EPSILON);
+                        for b in 0..D {
+                            assert!(
+                                (q.affine.cols[b][a] - a_m.cols[b][a]).abs() <= tol / hf,
+                                "{kernel:?} mac {mac}: C[{a}][{b}] {} vs {}",
+                                q.affine.cols[b][a],
+                                a_m.cols[b][a]
+                            );
+                        }
                     }
-                }
-                let f_want = (Mat::<f64, D>::identity() + a_m * dt) * p.f_e;
-                for j in 0..D {
-                    for r in 0..D {
-                        assert!((q.f_e.cols[j][r] - f_want.cols[j][r]).abs() <= tol * dt / hf);
+                    let f_want = (Mat::<f64, D>::identity() + a_m * dt) * p.f_e;
+                    for j in 0..D {
+                        for r in 0..D {
+                            assert!((q.f_e.cols[j][r] - f_want.cols[j][r]).abs() <= tol * dt / hf);
+                        }
                     }
                 }
             }
@@ -1024,7 +1031,8 @@ fn failures_write_nothing() {
             };
             let raw = s3.raw();
             // SAFETY: as above.
-            let st = unsafe { g2p::g2p_update(&thermal, &gargs, 1, &raw, &g3.g2p_view(), None) };
+            let st =
+                unsafe { g2p::g2p_update(isa, &thermal, &gargs, 1, &raw, &g3.g2p_view(), None) };
             match st.error {
                 None => {
                     let q = s3.get::<D>(0);
@@ -1066,8 +1074,9 @@ fn g2p_reads_only_stencil_nodes() {
         dt: 1e-3,
     };
     let raw = store.raw();
+    let isa = Isa::detect();
     // SAFETY: as above.
-    let st = unsafe { g2p::g2p_update(&mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
+    let st = unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
     assert_eq!(st.error, None);
     let mut s2 = Store::from(&ps[..1]);
     let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, hf, &ps[0].x).unwrap();
@@ -1075,7 +1084,7 @@ fn g2p_reads_only_stencil_nodes() {
     g.ch[MOM + 1][i] = T::NAN;
     let raw = s2.raw();
     // SAFETY: as above.
-    let st = unsafe { g2p::g2p_update(&mat, &args, 1, &raw, &g.g2p_view(), None) };
+    let st = unsafe { g2p::g2p_update(isa, &mat, &args, 1, &raw, &g.g2p_view(), None) };
     assert_eq!((st.first_failed, st.error), (0, Some(Error::NonFinite)));
     assert_eq!(s2, Store::from(&ps[..1]));
 }
@@ -1115,8 +1124,9 @@ where
             df: std::array::from_fn(|a| df.out(FORCE + a)),
         };
         // SAFETY: the channels cover the stencil.
-        let st =
-            unsafe { force::apply::<T, D>(kernel, h, 1, store.x.as_ptr(), slot.as_ptr(), &view) };
+        let st = unsafe {
+            force::apply::<T, D>(isa, kernel, h, 1, store.x.as_ptr(), slot.as_ptr(), &view)
+        };
         assert_eq!(st.error, None);
         for row in 0..m {
             k[row * m + col] = df.ch[FORCE + row % D][row / D].to_f64();
@@ -1288,6 +1298,7 @@ fn unprepared_slots_are_refused() {
         // SAFETY: one slot.
         let st = unsafe {
             force::apply::<T, D>(
+                isa,
                 Kernel::Quadratic,
                 0.05,
                 1,
@@ -1300,6 +1311,7 @@ fn unprepared_slots_are_refused() {
         // SAFETY: three slots.
         let st = unsafe {
             force::apply::<T, D>(
+                isa,
                 Kernel::Quadratic,
                 0.05,
                 3,

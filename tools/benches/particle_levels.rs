@@ -273,7 +273,7 @@ where
                     temperature_old: inp(D + 1),
                 };
                 // SAFETY: as above.
-                let s2 = unsafe { g2p::g2p_update(&mat, &g2p_args, n, &ps, &gv, None) };
+                let s2 = unsafe { g2p::g2p_update(isa, &mat, &g2p_args, n, &ps, &gv, None) };
                 black_box((s1, s2));
             })
         });
@@ -320,6 +320,7 @@ where
             // SAFETY: as above.
             unsafe {
                 force::apply::<T, D>(
+                    isa,
                     Kernel::Quadratic,
                     T::from_f64(H),
                     n,

@@ -249,7 +249,7 @@ fn g2p_view<T, const D: usize>(v: &AmpmG2pView<T>) -> Call<G2pView<T, D>> {
 }
 
 /// G2P + update batch; `faces` non-null selects the MAC form.
-pub(crate) unsafe fn g2p_update<T: Real, const D: usize>(
+pub(crate) unsafe fn g2p_update<T: BatchReal, const D: usize>(
     material: *const AmpmMaterial<T>,
     kernel: c_uint,
     h: T,
@@ -328,6 +328,7 @@ where
             None
         };
         Ok(done(g2p::g2p_update(
+            isa(),
             &mat,
             &args,
             n,
@@ -398,7 +399,7 @@ where
 }
 
 /// Force-differential apply.
-pub(crate) unsafe fn force_apply<T: Real, const D: usize>(
+pub(crate) unsafe fn force_apply<T: BatchReal, const D: usize>(
     kernel: c_uint,
     h: T,
     n: usize,
@@ -426,7 +427,15 @@ where
         if missing {
             return Err(AmpmStatus::AMPM_ERR_NULL_POINTER);
         }
-        Ok(done(force::apply::<T, D>(kernel, h, n, x, slots, &fv)))
+        Ok(done(force::apply::<T, D>(
+            isa(),
+            kernel,
+            h,
+            n,
+            x,
+            slots,
+            &fv,
+        )))
     })
 }
 

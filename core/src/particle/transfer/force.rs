@@ -8,7 +8,7 @@
 //! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
-use super::nodes::{nodes, off, rel_base, table, taint};
+use super::nodes::{add, nodes, read, rel_base, restore, table};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
@@ -23,6 +23,7 @@ use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::check_particle;
 use crate::particle::{Definiteness, Dilation, Material};
 use crate::scalar::Real;
+use core::mem::MaybeUninit;
 use core::ptr;
 
 /// The channels of the force differential: displacements read, force differentials added.
@@ -221,7 +222,8 @@ where
 /// # Safety
 /// `x` holds `n·d` scalars, `slots` `n·slot_len(d)`; every channel is valid at every node of
 /// `view.nodes`; `df` channels do not alias `du` channels or the slots.
-pub unsafe fn apply<T: Real, const D: usize>(
+pub unsafe fn apply<T: BatchReal, const D: usize>(
+    isa: Isa,
     kernel: Kernel,
     h: T,
     n: usize,
@@ -241,26 +243,65 @@ where
             error: Some(Error::InvalidArgument),
         };
     }
-    let sl = slot_len(D);
-    let mut first = FirstFailure::new(n);
-    for i in 0..n {
-        let slot = core::slice::from_raw_parts(slots.add(i * sl), sl);
-        let r = if slot[0] != tag::<T>(D) {
-            Err(Error::NotPrepared)
-        } else {
-            let xp = rd_vec::<T, D>(x, i);
-            match kernel {
-                Kernel::Quadratic => one::<T, D, 3>(kernel, h, &xp, slot, view),
-                Kernel::Cubic => one::<T, D, 4>(kernel, h, &xp, slot, view),
-            }
-        };
-        first.note(i, r);
-    }
-    first.status()
+    let mut op = ApplyOp {
+        kernel,
+        h,
+        n,
+        x,
+        slots,
+        view,
+    };
+    dispatch::<T, _>(isa, &mut op)
 }
 
+/// The particle loop of [`apply`], run with the instruction set's target features (the
+/// per-node arithmetic is written over arrays of nodes for the compiler to vectorise).
+struct ApplyOp<'a, T, const D: usize> {
+    kernel: Kernel,
+    h: T,
+    n: usize,
+    x: *const T,
+    slots: *const T,
+    view: &'a ForceView<T, D>,
+}
+
+impl<T: BatchReal, const D: usize> LaneOp<T> for ApplyOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline(always)]
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        let sl = slot_len(D);
+        let mut first = FirstFailure::new(self.n);
+        let (kernel, h, view) = (self.kernel, self.h, self.view);
+        for i in 0..self.n {
+            // SAFETY: `apply`'s contract: `slots` holds `n` slots, `x` `n` positions.
+            let r = unsafe {
+                let slot = core::slice::from_raw_parts(self.slots.add(i * sl), sl);
+                if slot[0] != tag::<T>(D) {
+                    Err(Error::NotPrepared)
+                } else {
+                    let xp = rd_vec::<T, D>(self.x, i);
+                    match kernel {
+                        Kernel::Quadratic if D == 2 => {
+                            one::<T, D, 3, 9>(kernel, h, &xp, slot, view)
+                        }
+                        Kernel::Quadratic => one::<T, D, 3, 27>(kernel, h, &xp, slot, view),
+                        Kernel::Cubic if D == 2 => one::<T, D, 4, 16>(kernel, h, &xp, slot, view),
+                        Kernel::Cubic => one::<T, D, 4, 64>(kernel, h, &xp, slot, view),
+                    }
+                }
+            };
+            first.note(i, r);
+        }
+        first.status()
+    }
+}
+
+/// One particle of [`apply`]: `G = Σ_j δu_j ∇w_jᵀ` over the nodes in order, `M = 𝒜(G)`, then
+/// `δf_i = M ∇w_i` added per channel, with every old value kept and put back on overflow.
 #[inline(always)]
-unsafe fn one<T: Real, const D: usize, const K: usize>(
+unsafe fn one<T: Real, const D: usize, const K: usize, const N: usize>(
     kernel: Kernel,
     h: T,
     x: &[T; D],
@@ -272,48 +313,44 @@ where
 {
     let s = Stencil::new(kernel, Grid::Collocated, h, x)?;
     let rel = rel_base(&s, &view.nodes)?;
-    let tu: [[[isize; 4]; D]; D] = core::array::from_fn(|a| table(&view.du[a], &rel));
-    let tf: [[[isize; 4]; D]; D] = core::array::from_fn(|a| table(&view.df[a], &rel));
-    let nd = nodes::<T, D, K>(&s);
-    let mut g = Mat::<T, D>::ZERO;
+    let mut u = [[T::ZERO; N]; D];
     let mut chk = true;
-    for r in 0..nd.n {
-        let (o, gr) = (nd.o[r], nd.g[r]);
-        for a in 0..D {
-            let u = ptr::read_unaligned(view.du[a].data.offset(off(&tu[a], &o)));
-            taint(&mut chk, u);
-            for b in 0..D {
-                g.cols[b][a] += u * gr[b];
-            }
-        }
+    for a in 0..D {
+        let c = &view.du[a];
+        chk &= read::<T, D, K, N>(c.data, &table(c, &rel), c.stride[0], &mut u[a]);
     }
     if !chk {
         return Err(Error::NonFinite);
     }
-    let m = apply_slot(slot, &g);
-    let nn = nd.n;
-    let mut old = [core::mem::MaybeUninit::<T>::uninit(); 64 * 3];
-    for r in 0..nn {
-        let o = nd.o[r];
-        let f = m.mul_vec(nd.g[r]);
+    let nd = nodes::<T, D, K, N>(&s);
+    let mut g = Mat::<T, D>::ZERO;
+    for i in 0..N {
         for a in 0..D {
-            let p = view.df[a].data.offset(off(&tf[a], &o));
-            let x = ptr::read_unaligned(p);
-            old[r * D + a].write(x);
-            let nv = x + f[a];
-            taint(&mut chk, nv);
-            ptr::write_unaligned(p, nv);
+            for b in 0..D {
+                g.cols[b][a] += u[a][i] * nd.g[b][i];
+            }
         }
     }
+    let m = apply_slot(slot, &g);
+    let mut f = [[T::ZERO; N]; D];
+    for i in 0..N {
+        let gi: [T; D] = core::array::from_fn(|b| nd.g[b][i]);
+        let fi = m.mul_vec(gi);
+        for a in 0..D {
+            f[a][i] = fi[a];
+        }
+    }
+    let mut old = [[MaybeUninit::<T>::uninit(); N]; D];
+    let mut tabs = [[[0isize; 4]; D]; D];
+    for a in 0..D {
+        let c = &view.df[a];
+        tabs[a] = table(c, &rel);
+        chk &= add::<T, D, K, N>(c.data, &tabs[a], c.stride[0], &f[a], &mut old[a]);
+    }
     if !chk {
-        // Put the old values back, last written first.
-        for r in (0..nn).rev() {
-            let o = nd.o[r];
-            for a in (0..D).rev() {
-                // SAFETY: written above.
-                let x = old[r * D + a].assume_init();
-                ptr::write_unaligned(view.df[a].data.offset(off(&tf[a], &o)), x);
-            }
+        for a in (0..D).rev() {
+            let c = &view.df[a];
+            restore::<T, D, K, N>(c.data, &tabs[a], c.stride[0], &old[a]);
         }
         return Err(Error::Overflow);
     }

@@ -10,16 +10,17 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{nodes, off, rel_base, table, taint};
+use super::nodes::{node_offsets, nodes, read, rel_base, table, taint};
 use super::{BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
 use crate::error::{Error, Result};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp};
+use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::{update_particle, G2pSample};
 use crate::particle::Material;
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
-use core::ptr;
 
 /// Where G2P reads: a node box and its channels.
 #[derive(Clone, Copy, Debug)]
@@ -60,7 +61,8 @@ pub struct G2pArgs<T> {
 /// # Safety
 /// The arrays of `ps` hold `n` particles; every channel read is valid at every node of its
 /// box; no channel aliases a particle array.
-pub unsafe fn g2p_update<T: Real, const D: usize>(
+pub unsafe fn g2p_update<T: BatchReal, const D: usize>(
+    isa: Isa,
     material: &Material<T>,
     args: &G2pArgs<T>,
     n: usize,
@@ -92,13 +94,56 @@ where
     if missing {
         return bad(Error::InvalidArgument);
     }
-    let checked = Checked::new(material);
-    let mut first = FirstFailure::new(n);
-    for i in 0..n {
-        let r = one(material, &checked, args, ps, view, faces, i);
-        first.note(i, r);
+    let mut op = G2pOp {
+        material,
+        checked: Checked::new(material),
+        args,
+        n,
+        ps,
+        view,
+        faces,
+    };
+    dispatch::<T, _>(isa, &mut op)
+}
+
+/// The particle loop of [`g2p_update`], run with the instruction set's target features (its
+/// per-node arithmetic is written over arrays of nodes for the compiler to vectorise; the
+/// lane type itself is not used).
+struct G2pOp<'a, T, const D: usize> {
+    material: &'a Material<T>,
+    checked: Checked,
+    args: &'a G2pArgs<T>,
+    n: usize,
+    ps: &'a Particles<T>,
+    view: &'a G2pView<T, D>,
+    faces: Option<&'a [G2pView<T, D>; D]>,
+}
+
+impl<T: BatchReal, const D: usize> LaneOp<T> for G2pOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    #[inline(always)]
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        let mut first = FirstFailure::new(self.n);
+        for i in 0..self.n {
+            // SAFETY: `g2p_update`'s contract.
+            let r = unsafe {
+                one(
+                    self.material,
+                    &self.checked,
+                    self.args,
+                    self.ps,
+                    self.view,
+                    self.faces,
+                    i,
+                )
+            };
+            first.note(i, r);
+        }
+        first.status()
     }
-    first.status()
 }
 
 #[inline(always)]
@@ -124,8 +169,10 @@ where
     checked.for_phase(p.phase)?;
     let k = args.kernel;
     let sample = match k {
-        Kernel::Quadratic => sample::<T, D, 3>(material, args, &p.x, view, faces)?,
-        Kernel::Cubic => sample::<T, D, 4>(material, args, &p.x, view, faces)?,
+        Kernel::Quadratic if D == 2 => sample::<T, D, 3, 9>(material, args, &p.x, view, faces)?,
+        Kernel::Quadratic => sample::<T, D, 3, 27>(material, args, &p.x, view, faces)?,
+        Kernel::Cubic if D == 2 => sample::<T, D, 4, 16>(material, args, &p.x, view, faces)?,
+        Kernel::Cubic => sample::<T, D, 4, 64>(material, args, &p.x, view, faces)?,
     };
     let (out, _) = update_particle(material, args.dt, &sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
@@ -137,35 +184,52 @@ where
 }
 
 /// Sums over the velocity channels of one stencil (components `comps`): per component
-/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite.
+/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite. The sums run
+/// over the nodes in order; the `1 + 2d` sums of a component are one short vector
+/// (`[w v, w v o₀…, v ∂w/∂x₀…] += [w v, …, v, …] ⊙ [1, o₀…, ∂w/∂x₀…]`, the same roundings as
+/// summing each on its own).
 #[inline(always)]
-unsafe fn sums<T: Real, const D: usize, const K: usize>(
+unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
     s: &Stencil<T, D>,
     rel: &[isize; D],
     ch: &[InChannel<T, D>; D],
     comps: (usize, usize),
 ) -> ([T; D], [[T; D]; D], [[T; D]; D], bool) {
+    let mut q = [[T::ZERO; N]; D];
+    let mut chk = true;
+    for a in comps.0..comps.1 {
+        let t = table(&ch[a], rel);
+        chk &= read::<T, D, K, N>(ch[a].data, &t, ch[a].stride[0], &mut q[a]);
+    }
+    let nd = nodes::<T, D, K, N>(s);
+    let oc = node_offsets::<T, D, K, N>();
+    let mut acc = [[T::ZERO; 8]; D];
+    for i in 0..N {
+        let mut rt = [T::ZERO; 8];
+        rt[0] = T::ONE;
+        for b in 0..D {
+            rt[1 + b] = oc[b][i];
+            rt[1 + D + b] = nd.g[b][i];
+        }
+        for a in comps.0..comps.1 {
+            let wq = nd.w[i] * q[a][i];
+            let mut lt = [T::ZERO; 8];
+            for (k, l) in lt.iter_mut().enumerate() {
+                *l = if k <= D { wq } else { q[a][i] };
+            }
+            for k in 0..8 {
+                acc[a][k] += lt[k] * rt[k];
+            }
+        }
+    }
     let mut v = [T::ZERO; D];
     let mut so = [[T::ZERO; D]; D];
     let mut g = [[T::ZERO; D]; D];
-    let mut chk = true;
-    let mut tabs = [[[0isize; 4]; D]; D];
     for a in comps.0..comps.1 {
-        tabs[a] = table(&ch[a], rel);
-    }
-    let oc: [T; 4] = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
-    let nd = nodes::<T, D, K>(s);
-    for r in 0..nd.n {
-        let (o, w, gr) = (nd.o[r], nd.w[r], nd.g[r]);
-        for a in comps.0..comps.1 {
-            let q = ptr::read_unaligned(ch[a].data.offset(off(&tabs[a], &o)));
-            taint(&mut chk, q);
-            let wq = w * q;
-            v[a] += wq;
-            for b in 0..D {
-                so[a][b] += wq * oc[o[b]];
-                g[a][b] += q * gr[b];
-            }
+        v[a] = acc[a][0];
+        for b in 0..D {
+            so[a][b] = acc[a][1 + b];
+            g[a][b] = acc[a][1 + D + b];
         }
     }
     (v, so, g, chk)
@@ -174,30 +238,27 @@ unsafe fn sums<T: Real, const D: usize, const K: usize>(
 /// `Σ w Tⁿ⁺¹` and `Σ w (Tⁿ⁺¹ − Tⁿ)` (the node difference is exact when the two are within a
 /// factor 2, Sterbenz), and whether every value read was finite.
 #[inline(always)]
-unsafe fn temperatures<T: Real, const D: usize, const K: usize>(
+unsafe fn temperatures<T: Real, const D: usize, const K: usize, const N: usize>(
     s: &Stencil<T, D>,
     rel: &[isize; D],
     new: &InChannel<T, D>,
     old: &InChannel<T, D>,
 ) -> (T, T, bool) {
-    let (mut pic, mut flip, mut chk) = (T::ZERO, T::ZERO, true);
-    let (tn, to) = (table(new, rel), table(old, rel));
-    let nd = nodes::<T, D, K>(s);
-    for r in 0..nd.n {
-        let (o, w) = (nd.o[r], nd.w[r]);
-        let a = ptr::read_unaligned(new.data.offset(off(&tn, &o)));
-        let b = ptr::read_unaligned(old.data.offset(off(&to, &o)));
-        taint(&mut chk, a);
-        taint(&mut chk, b);
-        pic += w * a;
-        flip += w * (a - b);
+    let (mut tn, mut to) = ([T::ZERO; N], [T::ZERO; N]);
+    let mut chk = read::<T, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
+    chk &= read::<T, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
+    let nd = nodes::<T, D, K, N>(s);
+    let (mut pic, mut flip) = (T::ZERO, T::ZERO);
+    for i in 0..N {
+        pic += nd.w[i] * tn[i];
+        flip += nd.w[i] * (tn[i] - to[i]);
     }
     (pic, flip, chk)
 }
 
 /// The grid sample of a particle at `x`.
 #[inline(always)]
-unsafe fn sample<T: Real, const D: usize, const K: usize>(
+unsafe fn sample<T: Real, const D: usize, const K: usize, const N: usize>(
     material: &Material<T>,
     args: &G2pArgs<T>,
     x: &[T; D],
@@ -236,7 +297,7 @@ where
     };
     match faces {
         None => {
-            let (v, so, g, ok) = sums::<T, D, K>(&s, &rel, &view.velocity, (0, D));
+            let (v, so, g, ok) = sums::<T, D, K, N>(&s, &rel, &view.velocity, (0, D));
             finite &= ok;
             for a in 0..D {
                 put(a, &s, &v, &so, &g);
@@ -246,7 +307,7 @@ where
             for a in 0..D {
                 let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
                 let rl = rel_base(&st, &f[a].nodes)?;
-                let (v, so, g, ok) = sums::<T, D, K>(&st, &rl, &f[a].velocity, (a, a + 1));
+                let (v, so, g, ok) = sums::<T, D, K, N>(&st, &rl, &f[a].velocity, (a, a + 1));
                 finite &= ok;
                 put(a, &st, &v, &so, &g);
             }
@@ -254,7 +315,7 @@ where
     }
     if material.heat.is_some() {
         let (pic, flip, ok) =
-            temperatures::<T, D, K>(&s, &rel, &view.temperature, &view.temperature_old);
+            temperatures::<T, D, K, N>(&s, &rel, &view.temperature, &view.temperature_old);
         finite &= ok;
         out.t_pic = pic;
         out.t_flip = flip;

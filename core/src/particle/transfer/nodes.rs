@@ -4,6 +4,8 @@ use super::{Channel, NodeBox};
 use crate::error::{Error, Result};
 use crate::particle::stencil::Stencil;
 use crate::scalar::Real;
+use core::mem::MaybeUninit;
+use core::ptr;
 
 /// `base − lo` of a stencil in a box, after checking that all `K^d` nodes are inside it.
 #[inline(always)]
@@ -23,16 +25,26 @@ pub(crate) fn rel_base<T: Real, const D: usize>(
     Ok(r)
 }
 
-/// Per-axis offsets `o` of stencil node `r` (axis 0 fastest), `K` nodes per axis.
-#[inline(always)]
-pub(crate) fn offsets<const D: usize, const K: usize>(r: usize) -> [usize; D] {
-    let mut o = [0usize; D];
-    let mut q = r;
-    for oa in o.iter_mut() {
-        *oa = q % K;
-        q /= K;
-    }
-    o
+/// Per-axis offsets of the `N = K^d` stencil nodes (axis 0 fastest), a compile-time table.
+pub(crate) struct Offsets<const D: usize, const K: usize, const N: usize>;
+
+impl<const D: usize, const K: usize, const N: usize> Offsets<D, K, N> {
+    /// `O[i][a]`: the offset along axis `a` of node `i = Σ_a o_a K^a`.
+    pub(crate) const O: [[usize; D]; N] = {
+        let mut o = [[0usize; D]; N];
+        let mut r = 0;
+        while r < N {
+            let mut q = r;
+            let mut a = 0;
+            while a < D {
+                o[r][a] = q % K;
+                q /= K;
+                a += 1;
+            }
+            r += 1;
+        }
+        o
+    };
 }
 
 /// Clears `ok` if `x` is not finite (a bit test, not a chain of floating-point adds).
@@ -41,32 +53,31 @@ pub(crate) fn taint<T: Real>(ok: &mut bool, x: T) {
     *ok &= x.is_finite();
 }
 
-/// The nodes of a stencil in stencil order (axis 0 fastest): offsets, weights and weight
-/// gradients, with the products of [`Stencil::node`] in its order (`w = w₀·w₁·w₂` left to
-/// right; `∂w/∂x_a = dw_a` times the other axes' weights in axis order).
-pub(crate) struct Nodes<T, const D: usize> {
-    /// Number of nodes, `K^d`.
-    pub n: usize,
-    /// Per-axis offsets of each node.
-    pub o: [[usize; D]; 64],
+/// The nodes of a stencil as arrays over the node index `i = Σ_a o_a K^a` (axis 0 fastest,
+/// `N = K^d` nodes): weights and weight gradients (1/m), with the products of
+/// [`Stencil::node`] in its order (`w = w₀·w₁·w₂` left to right; `∂w/∂x_a = dw_a` times the
+/// other axes' weights in axis order). Arrays over nodes let the per-node arithmetic of a
+/// particle run on SIMD lanes.
+pub(crate) struct Nodes<T, const D: usize, const N: usize> {
     /// Weights.
-    pub w: [T; 64],
-    /// Weight gradients (1/m).
-    pub g: [[T; D]; 64],
+    pub w: [T; N],
+    /// Weight gradients per axis (1/m).
+    pub g: [[T; N]; D],
 }
 
-/// The [`Nodes`] of a stencil with `K` nodes per axis.
+/// The [`Nodes`] of a stencil with `K` nodes per axis (`N = K^d`).
 #[inline(always)]
-pub(crate) fn nodes<T: Real, const D: usize, const K: usize>(s: &Stencil<T, D>) -> Nodes<T, D> {
+pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+) -> Nodes<T, D, N> {
+    debug_assert_eq!(N, K.pow(D as u32));
     let mut nd = Nodes {
-        n: K.pow(D as u32),
-        o: [[0; D]; 64],
-        w: [T::ZERO; 64],
-        g: [[T::ZERO; D]; 64],
+        w: [T::ZERO; N],
+        g: [[T::ZERO; N]; D],
     };
     let (w, dw) = (&s.w, &s.dw);
-    for r in 0..nd.n {
-        let o = offsets::<D, K>(r);
+    for r in 0..N {
+        let o = Offsets::<D, K, N>::O[r];
         let mut wt = w[0][o[0]];
         for a in 1..D {
             wt *= w[a][o[a]];
@@ -78,12 +89,26 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize>(s: &Stencil<T, D>) 
                     p *= w[b][o[b]];
                 }
             }
-            nd.g[r][a] = p;
+            nd.g[a][r] = p;
         }
-        nd.o[r] = o;
         nd.w[r] = wt;
     }
     nd
+}
+
+/// The offsets `o_a` of every node as scalars, per axis (`N = K^d` nodes, as [`Nodes`]).
+#[inline(always)]
+pub(crate) fn node_offsets<T: Real, const D: usize, const K: usize, const N: usize>() -> [[T; N]; D]
+{
+    let c = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
+    let mut oc = [[T::ZERO; N]; D];
+    for r in 0..N {
+        let o = Offsets::<D, K, N>::O[r];
+        for a in 0..D {
+            oc[a][r] = c[o[a]];
+        }
+    }
+    oc
 }
 
 /// Per-axis offset tables of a channel for one stencil: the node with offsets `o` is at
@@ -99,12 +124,92 @@ pub(crate) fn table<P, const D: usize>(c: &Channel<P, D>, rel: &[isize; D]) -> [
     t
 }
 
-/// The offset of node `o` from a table of [`table`].
+/// The offset of the first node of stencil row `r` from a table of [`table`]: row `r` holds
+/// the `K` nodes `r·K .. r·K + K`, which differ in axis 0 only (node `r·K + o₀` is `o₀·stride[0]`
+/// further).
 #[inline(always)]
-pub(crate) fn off<const D: usize>(t: &[[isize; 4]; D], o: &[usize; D]) -> isize {
-    let mut s = t[0][o[0]];
+pub(crate) fn row_off<const D: usize, const K: usize, const N: usize>(
+    t: &[[isize; 4]; D],
+    r: usize,
+) -> isize {
+    let o = Offsets::<D, K, N>::O[r * K];
+    let mut s = t[0][0];
     for a in 1..D {
         s += t[a][o[a]];
     }
     s
+}
+
+/// Reads an input channel at the `N = K^d` stencil nodes into `out` (node order of
+/// [`Nodes`]); `t` from [`table`], `s0` the channel's axis-0 stride. Returns whether every
+/// value read is finite.
+///
+/// # Safety
+/// Every stencil node is inside the channel's box (checked by [`rel_base`]).
+#[inline(always)]
+pub(crate) unsafe fn read<T: Real, const D: usize, const K: usize, const N: usize>(
+    data: *const T,
+    t: &[[isize; 4]; D],
+    s0: isize,
+    out: &mut [T; N],
+) -> bool {
+    let mut ok = true;
+    for r in 0..N / K {
+        let p = data.offset(row_off::<D, K, N>(t, r));
+        for o in 0..K {
+            let x = ptr::read_unaligned(p.offset(o as isize * s0));
+            taint(&mut ok, x);
+            out[r * K + o] = x;
+        }
+    }
+    ok
+}
+
+/// Adds `val` to an output channel at the `N = K^d` stencil nodes, keeping each old value in
+/// `old`. Returns whether every new value is finite (all are written either way; [`restore`]
+/// puts the old ones back).
+///
+/// # Safety
+/// As [`read`], and the channel is valid for writing.
+#[inline(always)]
+pub(crate) unsafe fn add<T: Real, const D: usize, const K: usize, const N: usize>(
+    data: *mut T,
+    t: &[[isize; 4]; D],
+    s0: isize,
+    val: &[T; N],
+    old: &mut [MaybeUninit<T>; N],
+) -> bool {
+    let mut ok = true;
+    for r in 0..N / K {
+        let p = data.offset(row_off::<D, K, N>(t, r));
+        for o in 0..K {
+            let q = p.offset(o as isize * s0);
+            let x = ptr::read_unaligned(q);
+            let nv = x + val[r * K + o];
+            taint(&mut ok, nv);
+            old[r * K + o].write(x);
+            ptr::write_unaligned(q, nv);
+        }
+    }
+    ok
+}
+
+/// Puts back the old values that [`add`] kept, last written first (so that a node reached
+/// twice through aliased channels gets its first old value back).
+///
+/// # Safety
+/// As [`add`], with `old` filled by it for the same channel and stencil.
+#[inline(always)]
+pub(crate) unsafe fn restore<T: Real, const D: usize, const K: usize, const N: usize>(
+    data: *mut T,
+    t: &[[isize; 4]; D],
+    s0: isize,
+    old: &[MaybeUninit<T>; N],
+) {
+    for r in (0..N / K).rev() {
+        let p = data.offset(row_off::<D, K, N>(t, r));
+        for o in (0..K).rev() {
+            ptr::write_unaligned(p.offset(o as isize * s0), old[r * K + o].assume_init());
+        }
+    }
 }

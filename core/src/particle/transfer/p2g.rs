@@ -11,7 +11,7 @@
 //! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
 //! node loop is per particle.
 
-use super::nodes::{nodes, off, rel_base, table, taint};
+use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint};
 use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
@@ -24,6 +24,7 @@ use crate::particle::dilation;
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::check_particle;
 use crate::particle::{Dilation, Material, Particle};
+use core::mem::MaybeUninit;
 use core::ptr;
 
 /// Where P2G writes: a node box and the channels to scatter-add into (absent channels are
@@ -223,11 +224,12 @@ where
         })
     }
 
-    /// Scatter-adds one particle. Every node value is written as it is formed, its old value
-    /// kept; if one is not finite, the old values are put back (in reverse order, so that
-    /// aliased channels are restored too) and the particle fails.
+    /// Scatter-adds one particle (`K` nodes per axis, `N = K^d`). The node values of each
+    /// channel are formed as arrays over the nodes, then added channel by channel; every old
+    /// value is kept, and if a new one is not finite the old values are put back (in reverse
+    /// order, so that aliased channels are restored too) and the particle fails.
     #[inline(always)]
-    unsafe fn scatter<const K: usize>(&self, r: &Ready<T, D>) -> Result<()> {
+    unsafe fn scatter<const K: usize, const N: usize>(&self, r: &Ready<T, D>) -> Result<()> {
         let v = self.view;
         let rel = rel_base(&r.s, &v.nodes)?;
         let comps: (usize, usize) = match self.args.grid {
@@ -235,14 +237,14 @@ where
             Grid::Face(a) => (a, a + 1),
         };
         let heat_on = self.material.heat.is_some() && self.args.grid == Grid::Collocated;
-        // The active channels: (kind, data, offset table).
-        let mut act: [(usize, *mut T, [[isize; 4]; D]); CH] =
-            [(0, ptr::null_mut(), [[0; 4]; D]); CH];
+        // The active channels: (kind, data, offset table, axis-0 stride).
+        let mut act: [(usize, *mut T, [[isize; 4]; D], isize); CH] =
+            [(0, ptr::null_mut(), [[0; 4]; D], 0); CH];
         let mut na = 0;
         {
             let mut add = |kind: usize, ch: &OutChannel<T, D>| {
                 if !ch.data.is_null() {
-                    act[na] = (kind, ch.data, table(ch, &rel));
+                    act[na] = (kind, ch.data, table(ch, &rel), ch.stride[0]);
                     na += 1;
                 }
             };
@@ -258,62 +260,58 @@ where
             }
         }
         let act = &act[..na];
-        let mut old = [core::mem::MaybeUninit::<T>::uninit(); 64 * CH];
-        let mut k = 0;
-        let mut chk = true;
+        // Node values per channel kind (only the active kinds are read).
+        let nd = nodes::<T, D, K, N>(&r.s);
+        let oc = node_offsets::<T, D, K, N>();
         let idt = self.args.impulse_dt;
-        let oc: [T; 4] = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
-        let nd = nodes::<T, D, K>(&r.s);
-        for node in 0..nd.n {
-            let (o, w, g) = (nd.o[node], nd.w[node], nd.g[node]);
-            let mut val = [T::ZERO; CH];
-            val[0] = w * r.mass;
-            for a in 0..D {
+        let mut val = [[T::ZERO; N]; CH];
+        for i in 0..N {
+            val[0][i] = nd.w[i] * r.mass;
+        }
+        for a in comps.0..comps.1 {
+            for i in 0..N {
                 let mut f = T::ZERO;
                 let mut q = r.q0[a];
                 for b in 0..D {
-                    f += r.fm.cols[b][a] * g[b];
-                    q += r.mch.cols[b][a] * oc[o[b]];
+                    f += r.fm.cols[b][a] * nd.g[b][i];
+                    q += r.mch.cols[b][a] * oc[b][i];
                 }
-                val[4 + a] = f;
-                val[1 + a] = w * q + idt * f;
-            }
-            for c in 0..3 {
-                val[7 + c] = w * r.heat[c];
-            }
-            for (kind, data, t) in act {
-                let p = data.offset(off(t, &o));
-                let x = ptr::read_unaligned(p);
-                let nv = x + val[*kind];
-                taint(&mut chk, nv);
-                old[k].write(x);
-                k += 1;
-                ptr::write_unaligned(p, nv);
+                val[4 + a][i] = f;
+                val[1 + a][i] = nd.w[i] * q + idt * f;
             }
         }
-        if chk {
+        if heat_on {
+            for c in 0..3 {
+                for i in 0..N {
+                    val[7 + c][i] = nd.w[i] * r.heat[c];
+                }
+            }
+        }
+        let mut old = [[MaybeUninit::<T>::uninit(); N]; CH];
+        let mut ok = true;
+        for (j, (kind, data, t, s0)) in act.iter().enumerate() {
+            ok &= add::<T, D, K, N>(*data, t, *s0, &val[*kind], &mut old[j]);
+        }
+        if ok {
             return Ok(());
         }
-        // Put the old values back, last written first.
-        for node in (0..nd.n).rev() {
-            let o = nd.o[node];
-            for (j, (_, data, t)) in act.iter().enumerate().rev() {
-                // SAFETY: written by the node loop above.
-                let x = old[node * na + j].assume_init();
-                ptr::write_unaligned(data.offset(off(t, &o)), x);
-            }
+        for (j, (_, data, t, s0)) in act.iter().enumerate().rev() {
+            restore::<T, D, K, N>(*data, t, *s0, &old[j]);
         }
         Err(Error::Overflow)
     }
 
     #[inline(always)]
     unsafe fn finish(&mut self, i: usize, pre: &Pre<T, D>, tau_dev: Mat<T, D>) {
-        let r = self
-            .ready(pre, tau_dev)
-            .and_then(|r| match self.args.kernel {
-                Kernel::Quadratic => self.scatter::<3>(&r),
-                Kernel::Cubic => self.scatter::<4>(&r),
-            });
+        let r = match self.ready(pre, tau_dev) {
+            Err(e) => Err(e),
+            Ok(r) => match self.args.kernel {
+                Kernel::Quadratic if D == 2 => self.scatter::<3, 9>(&r),
+                Kernel::Quadratic => self.scatter::<3, 27>(&r),
+                Kernel::Cubic if D == 2 => self.scatter::<4, 16>(&r),
+                Kernel::Cubic => self.scatter::<4, 64>(&r),
+            },
+        };
         self.first.note(i, r);
     }
 }
