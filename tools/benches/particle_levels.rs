@@ -315,22 +315,24 @@ where
             stride,
         }),
     };
-    g.bench_function(format!("force_apply/{name}"), |b| {
-        b.iter(|| {
-            // SAFETY: as above.
-            unsafe {
-                force::apply::<T, D>(
-                    isa,
-                    Kernel::Quadratic,
-                    T::from_f64(H),
-                    n,
-                    sc.x.as_ptr(),
-                    slots.as_ptr(),
-                    &view,
-                )
-            }
-        })
-    });
+    for isa in Isa::available() {
+        g.bench_function(format!("force_apply/{name}/{}", isa.name()), |b| {
+            b.iter(|| {
+                // SAFETY: as above.
+                unsafe {
+                    force::apply::<T, D>(
+                        isa,
+                        Kernel::Quadratic,
+                        T::from_f64(H),
+                        n,
+                        sc.x.as_ptr(),
+                        slots.as_ptr(),
+                        &view,
+                    )
+                }
+            })
+        });
+    }
     du.clear();
     df.clear();
 }
