@@ -412,8 +412,33 @@ where
     update_checked(material, dt, s, p)
 }
 
+/// [`update_particle`] for a caller that has validated the material for the particle's phase
+/// (`material.validate(p.phase)`, as the batch transfers do once per call): the particle,
+/// `dt` and temperature checks and the update, inlined into the caller's loop.
+#[inline(always)]
+pub(crate) fn update_validated<T: Real, const D: usize>(
+    material: &Material<T>,
+    dt: T,
+    s: &G2pSample<T, D>,
+    p: &Particle<T, D>,
+) -> Result<(Particle<T, D>, UpdateInfo<T>)>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    check_particle(p)?;
+    if !dt.is_finite() {
+        return Err(Error::NonFinite);
+    }
+    if dt <= T::ZERO {
+        return Err(Error::InvalidArgument);
+    }
+    check_temperature(material, p)?;
+    update_checked(material, dt, s, p)
+}
+
 /// [`update_particle`] after its input checks ([`check_update_inputs`], the temperature).
-#[inline]
+#[inline(always)]
 fn update_checked<T: Real, const D: usize>(
     material: &Material<T>,
     dt: T,

@@ -3,7 +3,7 @@
 //! Per particle (Jiang et al. 2015, §5.3 and §6 for MAC grids): `v_p = Σ w_i v_i`,
 //! `C_p = Σ w_i v_i (x_i − x_p)ᵀ / (κ h²)` (`κ` = [`Kernel::apic_moment`]), `∇v_p = Σ v_i ∇w_iᵀ`,
 //! and with heat on `T_pic = Σ w_i T_iⁿ⁺¹`, `ΔT_flip = Σ w_i (T_iⁿ⁺¹ − T_iⁿ)`; then
-//! [`update_particle`] (temperature and phase, advection, `F_E` with its remedy, the liquid
+//! [`crate::particle::update::update_particle`] (temperature and phase, advection, `F_E` with its remedy, the liquid
 //! projection or snow plasticity). On a MAC grid component `a` of `v_p`, row `a` of `C_p` and
 //! of `∇v_p` come from face grid `a` with its own stencil; temperatures stay collocated.
 //!
@@ -17,7 +17,7 @@ use crate::kernel::batch::{dispatch, BatchReal, LaneOp};
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
-use crate::particle::update::{update_particle, G2pSample};
+use crate::particle::update::{update_validated, G2pSample};
 use crate::particle::Material;
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
@@ -53,7 +53,7 @@ pub struct G2pArgs<T> {
 /// Reads every particle array the material needs; writes `x, v, affine, f_e, f_p`, and
 /// `temperature`, `latent`, `phase` as the material says. A failed particle keeps its state.
 ///
-/// Errors per particle: those of [`update_particle`], [`Error::OutsideGrid`],
+/// Errors per particle: those of [`crate::particle::update::update_particle`], [`Error::OutsideGrid`],
 /// [`Error::NonFinite`] for a non-finite node value that the particle reads, [`Error::Overflow`]
 /// for sums that overflow. Whole-call errors (a null array the material needs, a null velocity
 /// channel, null temperature channels with heat on) are reported for particle 0.
@@ -174,7 +174,8 @@ where
         Kernel::Cubic if D == 2 => sample::<T, D, 4, 16>(material, args, &p.x, view, faces)?,
         Kernel::Cubic => sample::<T, D, 4, 64>(material, args, &p.x, view, faces)?,
     };
-    let (out, _) = update_particle(material, args.dt, &sample, &p)?;
+    // The material was validated for this phase above (`checked`).
+    let (out, _) = update_validated(material, args.dt, &sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
         // The cell index of the new position is beyond the supported range (as g2p_update).
         return Err(Error::Overflow);
