@@ -34,6 +34,13 @@
 // would: per particle one Eigen::JacobiSVD (full U, V) for the polar decomposition of the
 // stress, the same B-spline loops, the same grid arrays, built with the flags below.
 //
+// ampm.hpp (zero-cost check): the elastic 3D f32 step (zeroing + P2G sym + grid + G2P) written
+// against the C++ wrapper include/ampm.hpp (Material, Particles and view builders, ampm::p2g,
+// ampm::g2p_update; builders made where the C path fills its structs) is timed in the same run,
+// alternating with the C step rep by rep on the default instruction set; the ratio hpp / C of
+// the medians is reported (≈ 1.00 when the wrapper costs nothing). Before timing, and in
+// --check, the wrapper's step must give bit-identical grids and particles to the C step.
+//
 // --check (and every timing run, before timing): on tiny blocks (6³, 14²), every call returns
 // AMPM_OK with first_failed = n and finite results; for the elastic scene the library's and the
 // baseline's P2G grids and G2P particles agree with the same loop evaluated in long double
@@ -47,6 +54,8 @@
 #include "ampm.h"
 
 #include <Eigen/Dense>
+
+#include "ampm.hpp"
 
 #include <algorithm>
 #include <array>
@@ -1040,6 +1049,121 @@ std::string compiler() {
   return c;
 }
 
+// ---- the same step through ampm.hpp -------------------------------------------------------
+
+/// The elastic scene's material, built with ampm.hpp's named setters (the fields the C path's
+/// material() sets; equal bytes, checked in check_hpp).
+inline ampm::Material<float> hpp_material() {
+  const auto c = material<float, 3>(Scene::Elastic, false);
+  return ampm::Material<float>()
+      .model(c.model)
+      .solid(ampm::PhaseParams<float>().mu(c.solid.mu).inv_lambda(c.solid.inv_lambda)
+                 .heat_capacity(c.solid.heat_capacity).conductivity(c.solid.conductivity))
+      .liquid(ampm::PhaseParams<float>().mu(c.liquid.mu).inv_lambda(c.liquid.inv_lambda)
+                  .heat_capacity(c.liquid.heat_capacity).conductivity(c.liquid.conductivity))
+      .melting_point(c.melting_point)
+      .latent_heat(c.latent_heat)
+      .flip(c.flip)
+      .critical_compression(c.critical_compression)
+      .critical_stretch(c.critical_stretch)
+      .hardening(c.hardening);
+}
+
+/// One host step (zero + P2G sym + grid + G2P) of the elastic 3D f32 case through ampm.hpp:
+/// the material and particle builders are made per call, as the C path fills its structs.
+struct HppStep {
+  Case<float, 3>& cs;
+  ampm::P2gView<float, 3> p2g_view;
+  ampm::G2pView<float, 3> g2p_view;
+  explicit HppStep(Case<float, 3>& c)
+      : cs(c),
+        p2g_view(ampm::P2gView<float, 3>::separate(c.g.box(), c.g.mass.data(),
+                                                   {c.g.mom[0].data(), c.g.mom[1].data(), c.g.mom[2].data()})),
+        g2p_view(ampm::G2pView<float, 3>::separate(c.g.box(), {c.g.vel[0].data(), c.g.vel[1].data(), c.g.vel[2].data()})) {}
+  ampm::Particles<float, 3> particles() {
+    auto& p = cs.p;
+    ampm::Particles<float, 3> q(p.n);
+    q.x(p.x.data()).v(p.v.data()).affine(p.c.data()).f_e(p.fe.data()).f_p(p.fp.data()).mass(p.m.data())
+        .volume0(p.v0.data()).temperature(p.t.data()).latent(p.u.data()).phase(p.ph.data());
+    return q;
+  }
+  void step() {
+    cs.g.zero_p2g();
+    const auto a = ampm::p2g(hpp_material(), AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, cs.h, cs.dt, particles(), p2g_view);
+    expect_ok("ampm.hpp P2G sym", a.code(), a.first_failed, cs.p.n);
+    grid_update(cs.g, false);
+    const auto b = ampm::g2p_update(hpp_material(), AMPM_KERNEL_QUADRATIC, cs.h, cs.dt, particles(), g2p_view);
+    expect_ok("ampm.hpp G2P", b.code(), b.first_failed, cs.p.n);
+  }
+};
+
+/// The C step of the elastic case (the `step` column's body).
+void c_step(Case<float, 3>& cs) {
+  std::size_t ff = 0;
+  cs.g.zero_p2g();
+  const AmpmStatus a = cs.p2g_sym(&ff);
+  expect_ok(cs.label("P2G sym"), a, ff, cs.p.n);
+  grid_update(cs.g, false);
+  const AmpmStatus b = cs.g2p(&ff);
+  expect_ok(cs.label("G2P"), b, ff, cs.p.n);
+}
+
+/// ampm.hpp's step equals the C step bit for bit (grid and particles), and its structs are the
+/// C path's bytes.
+void check_hpp(int per_axis, CheckLog& log) {
+  Case<float, 3> a(Scene::Elastic, per_axis), b(Scene::Elastic, per_axis);
+  HppStep hs(b);
+  const auto cm = material<float, 3>(Scene::Elastic, false);
+  const auto hm = hpp_material();
+  auto pv = b.p.view();
+  const bool structs = std::memcmp(&cm, &hm.c(), sizeof cm) == 0 &&
+                       std::memcmp(&pv, &hs.particles().c(), sizeof pv) == 0;
+  bool same = structs;
+  for (int step = 0; step < 3; ++step) {
+    c_step(a);
+    hs.step();
+    auto eq = [](const std::vector<float>& x, const std::vector<float>& y) {
+      return x.size() == y.size() && std::memcmp(x.data(), y.data(), x.size() * sizeof(float)) == 0;
+    };
+    same = same && eq(a.g.mass, b.g.mass) && eq(a.p.x, b.p.x) && eq(a.p.v, b.p.v) && eq(a.p.c, b.p.c) &&
+           eq(a.p.fe, b.p.fe);
+    for (int d = 0; d < 3; ++d) same = same && eq(a.g.mom[d], b.g.mom[d]);
+  }
+  const std::string line = std::string("3D f32 elastic step through ampm.hpp vs the C calls, 3 steps: ") +
+                           (same ? "same struct bytes, bit-identical grids and particles"
+                                 : structs ? "DIFFERENT results" : "DIFFERENT struct bytes");
+  log.add(line);
+  if (!same) fail(line);
+}
+
+struct HppTiming {
+  std::size_t n = 0;
+  double c = NAN, hpp = NAN, c_min = NAN, hpp_min = NAN;
+};
+
+/// The C step and the ampm.hpp step, alternating rep by rep (one warm-up each), ns per particle.
+HppTiming time_hpp(int per_axis, int reps) {
+  Case<float, 3> cs(Scene::Elastic, per_axis);
+  HppStep hs(cs);
+  std::vector<double> tc, th;
+  auto once = [&](auto&& body) {
+    cs.restore();
+    const auto t0 = std::chrono::steady_clock::now();
+    body();
+    const auto t1 = std::chrono::steady_clock::now();
+    return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(cs.p.n);
+  };
+  for (int r = -1; r < reps; ++r) {
+    const double a = once([&] { c_step(cs); });
+    const double b = once([&] { hs.step(); });
+    if (r >= 0) tc.push_back(a), th.push_back(b);
+  }
+  std::sort(tc.begin(), tc.end());
+  std::sort(th.begin(), th.end());
+  cs.restore();
+  return {cs.p.n, tc[tc.size() / 2], th[th.size() / 2], tc.front(), th.front()};
+}
+
 std::string fmt(double ns) {
   if (std::isnan(ns)) return "n/a";
   char b[32];
@@ -1063,8 +1187,9 @@ std::string verdict(double got, double target) {
   return got <= target ? " ✓" : " ✗";
 }
 
-std::string report(const std::vector<Row>& rows, const Baseline& base, const std::vector<std::string>& checks, int reps,
-                   std::uint32_t default_isa, const std::string& load_before) {
+std::string report(const std::vector<Row>& rows, const Baseline& base, const HppTiming& hpp,
+                   const std::vector<std::string>& checks, int reps, std::uint32_t default_isa,
+                   const std::string& load_before) {
   std::ostringstream o;
   o << "# ampm particle transfers in a host's step loop\n\n";
   o << "CPU: " << cpu_model() << "; default instruction set (`ampm_isa()`): " << isa_name(default_isa)
@@ -1117,6 +1242,15 @@ std::string report(const std::vector<Row>& rows, const Baseline& base, const std
   std::snprintf(ratio, sizeof ratio, "%.2f", (base.p2g + base.g2p) / lib_elastic);
   o << "| Eigen baseline | " << fmt(base.p2g) << " | " << fmt(base.g2p) << " | " << fmt(base.p2g + base.g2p) << " | "
     << ratio << " |\n\n";
+  o << "C++ wrapper `include/ampm.hpp`, elastic 3D f32 (" << hpp.n << " particles, " << isa_name(default_isa)
+    << "): the step (zeroing + P2G sym + grid + G2P) through `ampm::p2g` / `ampm::g2p_update` with the "
+       "builders made per call, against the same step through the C calls, alternating rep by rep.\n\n";
+  char hr[32], hr_min[32];
+  std::snprintf(hr, sizeof hr, "%.2f", hpp.hpp / hpp.c);
+  std::snprintf(hr_min, sizeof hr_min, "%.2f", hpp.hpp_min / hpp.c_min);
+  o << "| | step, C calls | step, ampm.hpp | ampm.hpp / C |\n|---|---:|---:|---:|\n";
+  o << "| median | " << fmt(hpp.c) << " | " << fmt(hpp.hpp) << " | " << hr << " |\n";
+  o << "| fastest run | " << fmt(hpp.c_min) << " | " << fmt(hpp.hpp_min) << " | " << hr_min << " |\n\n";
   o << "Agreement checks (run before timing; `bench_transfers --check` runs them alone on 6³ / 14² blocks):\n\n";
   for (const std::string& c : checks) o << "- " << c << "\n";
   return o.str();
@@ -1195,6 +1329,7 @@ int main(int argc, char** argv) {
     check_isas<double, 2>(s, 14, isas, log);
   }
   ampm_set_isa(default_isa);
+  check_hpp(6, log);
   if (check) {
     std::printf("bench_transfers --check: all results agree\n");
     if (!out_given) return 0;
@@ -1212,7 +1347,10 @@ int main(int argc, char** argv) {
   }
   ampm_set_isa(default_isa);
   const Baseline base = time_baseline(n3, reps);
-  const std::string text = report(rows, base, log.lines, reps, default_isa, load_before);
+  const HppTiming hpp = time_hpp(n3, reps);
+  std::fprintf(stderr, "ampm.hpp elastic 3D f32 step: C %.1f ns, ampm.hpp %.1f ns, ratio %.3f (fastest %.3f)\n", hpp.c,
+               hpp.hpp, hpp.hpp / hpp.c, hpp.hpp_min / hpp.c_min);
+  const std::string text = report(rows, base, hpp, log.lines, reps, default_isa, load_before);
   std::fputs(text.c_str(), stdout);
   std::ofstream f(out);
   f << text;
