@@ -34,6 +34,7 @@ pub mod apic;
 pub mod deformation;
 pub mod dilation;
 pub mod implicit;
+pub mod pressure;
 pub mod stencil;
 pub mod stiffness;
 pub mod thermal;

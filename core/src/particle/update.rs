@@ -350,6 +350,15 @@ where
     Mat<T, D>: Matrix<Scalar = T>,
 {
     material.validate(p.phase)?;
+    check_particle_dt(p, dt)
+}
+
+/// The particle and `Δt` checks of [`update_particle`].
+#[inline(always)]
+fn check_particle_dt<T: Real, const D: usize>(p: &Particle<T, D>, dt: T) -> Result<()>
+where
+    Mat<T, D>: Matrix<Scalar = T>,
+{
     check_particle(p)?;
     if !dt.is_finite() {
         return Err(Error::NonFinite);
@@ -426,13 +435,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    check_particle(p)?;
-    if !dt.is_finite() {
-        return Err(Error::NonFinite);
-    }
-    if dt <= T::ZERO {
-        return Err(Error::InvalidArgument);
-    }
+    check_particle_dt(p, dt)?;
     check_temperature(material, p)?;
     update_checked(material, dt, s, p)
 }
@@ -607,37 +610,7 @@ where
     Ok((out, info))
 }
 
-/// The particle pressure `p = −Ψ_λ'(J_E)/J_P` (Pa) with the particle's (hardened) `λ`
-/// ([`dilation::pressure`]).
-///
-/// Errors: invalid material or particle; [`Error::InvalidArgument`] when `1/λ = 0`.
-#[inline]
-pub fn pressure<T: Real, const D: usize>(material: &Material<T>, p: &Particle<T, D>) -> Result<T>
-where
-    Mat<T, D>: Matrix<Scalar = T>,
-{
-    material.validate(p.phase)?;
-    let (j_e, j_p) = check_particle(p)?;
-    dilation::pressure(j_e, j_p, material.moduli(p.phase, j_p)?.inv_lambda)
-}
-
-/// The pressure-solve coefficient `J_P/(Δt λ J_E)` (1/(Pa·s)) of a particle
-/// ([`dilation::pressure_coefficient`]), 0 when incompressible.
-///
-/// Errors: invalid material, particle or `Δt`.
-#[inline]
-pub fn pressure_coefficient<T: Real, const D: usize>(
-    material: &Material<T>,
-    p: &Particle<T, D>,
-    dt: T,
-) -> Result<T>
-where
-    Mat<T, D>: Matrix<Scalar = T>,
-{
-    material.validate(p.phase)?;
-    let (j_e, j_p) = check_particle(p)?;
-    dilation::pressure_coefficient(j_e, j_p, material.moduli(p.phase, j_p)?.inv_lambda, dt)
-}
+pub use super::pressure::{pressure, pressure_coefficient};
 
 #[cfg(test)]
 mod tests {
