@@ -87,7 +87,7 @@ fn write(path: &Path, text: &str) -> Result<(), String> {
 
 fn run() -> Result<(), String> {
     let opt = parse_args()?;
-    let font = charts::init_font()?;
+    let font = ampm_tools::font::init_font()?;
     std::fs::create_dir_all(&opt.out)
         .map_err(|e| format!("creating {}: {e}", opt.out.display()))?;
     let out = opt
