@@ -8,7 +8,7 @@
 //! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
-use super::nodes::{add, nodes, read, rel_base, restore, table};
+use super::nodes::{add, nodes, read, rel_base, restore, table, with_nodes};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
@@ -282,14 +282,9 @@ where
                     Err(Error::NotPrepared)
                 } else {
                     let xp = rd_vec::<T, D>(self.x, i);
-                    match kernel {
-                        Kernel::Quadratic if D == 2 => {
-                            one::<T, D, 3, 9>(kernel, h, &xp, slot, view)
-                        }
-                        Kernel::Quadratic => one::<T, D, 3, 27>(kernel, h, &xp, slot, view),
-                        Kernel::Cubic if D == 2 => one::<T, D, 4, 16>(kernel, h, &xp, slot, view),
-                        Kernel::Cubic => one::<T, D, 4, 64>(kernel, h, &xp, slot, view),
-                    }
+                    with_nodes!(kernel, D, |K, N| one::<T, D, K, N>(
+                        kernel, h, &xp, slot, view
+                    ))
                 }
             };
             first.note(i, r);

@@ -10,7 +10,7 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{node_offsets, nodes, read, rel_base, table, taint};
+use super::nodes::{node_offsets, nodes, read, rel_base, table, taint, with_nodes, Nodes};
 use super::{BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp};
@@ -167,13 +167,9 @@ where
     };
     let p = ps.get::<D>(i, reads, material)?;
     checked.for_phase(p.phase)?;
-    let k = args.kernel;
-    let sample = match k {
-        Kernel::Quadratic if D == 2 => sample::<T, D, 3, 9>(material, args, &p.x, view, faces)?,
-        Kernel::Quadratic => sample::<T, D, 3, 27>(material, args, &p.x, view, faces)?,
-        Kernel::Cubic if D == 2 => sample::<T, D, 4, 16>(material, args, &p.x, view, faces)?,
-        Kernel::Cubic => sample::<T, D, 4, 64>(material, args, &p.x, view, faces)?,
-    };
+    let sample = with_nodes!(args.kernel, D, |K, N| sample::<T, D, K, N>(
+        material, args, &p.x, view, faces
+    ))?;
     // The material was validated for this phase above (`checked`).
     let (out, _) = update_validated(material, args.dt, &sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
@@ -191,7 +187,7 @@ where
 /// summing each on its own).
 #[inline(always)]
 unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
-    s: &Stencil<T, D>,
+    nd: &Nodes<T, D, N>,
     rel: &[isize; D],
     ch: &[InChannel<T, D>; D],
     comps: (usize, usize),
@@ -202,7 +198,6 @@ unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
         let t = table(&ch[a], rel);
         chk &= read::<T, D, K, N>(ch[a].data, &t, ch[a].stride[0], &mut q[a]);
     }
-    let nd = nodes::<T, D, K, N>(s);
     let oc = node_offsets::<T, D, K, N>();
     let mut acc = [[T::ZERO; 8]; D];
     for i in 0..N {
@@ -240,7 +235,7 @@ unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
 /// factor 2, Sterbenz), and whether every value read was finite.
 #[inline(always)]
 unsafe fn temperatures<T: Real, const D: usize, const K: usize, const N: usize>(
-    s: &Stencil<T, D>,
+    nd: &Nodes<T, D, N>,
     rel: &[isize; D],
     new: &InChannel<T, D>,
     old: &InChannel<T, D>,
@@ -248,7 +243,6 @@ unsafe fn temperatures<T: Real, const D: usize, const K: usize, const N: usize>(
     let (mut tn, mut to) = ([T::ZERO; N], [T::ZERO; N]);
     let mut chk = read::<T, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
     chk &= read::<T, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
-    let nd = nodes::<T, D, K, N>(s);
     let (mut pic, mut flip) = (T::ZERO, T::ZERO);
     for i in 0..N {
         pic += nd.w[i] * tn[i];
@@ -296,9 +290,11 @@ where
             out.grad_v.cols[b][a] = g[a][b];
         }
     };
+    // The collocated stencil's nodes, once for its velocities and temperatures.
+    let nd = nodes::<T, D, K, N>(&s);
     match faces {
         None => {
-            let (v, so, g, ok) = sums::<T, D, K, N>(&s, &rel, &view.velocity, (0, D));
+            let (v, so, g, ok) = sums::<T, D, K, N>(&nd, &rel, &view.velocity, (0, D));
             finite &= ok;
             for a in 0..D {
                 put(a, &s, &v, &so, &g);
@@ -308,7 +304,8 @@ where
             for a in 0..D {
                 let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
                 let rl = rel_base(&st, &f[a].nodes)?;
-                let (v, so, g, ok) = sums::<T, D, K, N>(&st, &rl, &f[a].velocity, (a, a + 1));
+                let nf = nodes::<T, D, K, N>(&st);
+                let (v, so, g, ok) = sums::<T, D, K, N>(&nf, &rl, &f[a].velocity, (a, a + 1));
                 finite &= ok;
                 put(a, &st, &v, &so, &g);
             }
@@ -316,7 +313,7 @@ where
     }
     if material.heat.is_some() {
         let (pic, flip, ok) =
-            temperatures::<T, D, K, N>(&s, &rel, &view.temperature, &view.temperature_old);
+            temperatures::<T, D, K, N>(&nd, &rel, &view.temperature, &view.temperature_old);
         finite &= ok;
         out.t_pic = pic;
         out.t_flip = flip;

@@ -96,6 +96,36 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
     nd
 }
 
+/// Evaluates `body` with the constants `K` (nodes per axis of `kernel`) and `N = K^d` (nodes
+/// of a stencil in dimension `d`) in scope, for the const-generic node loops.
+macro_rules! with_nodes {
+    ($kernel:expr, $d:expr, |$k:ident, $n:ident| $body:expr) => {
+        match ($kernel, $d == 2) {
+            ($crate::particle::stencil::Kernel::Quadratic, true) => {
+                const $k: usize = 3;
+                const $n: usize = 9;
+                $body
+            }
+            ($crate::particle::stencil::Kernel::Quadratic, false) => {
+                const $k: usize = 3;
+                const $n: usize = 27;
+                $body
+            }
+            ($crate::particle::stencil::Kernel::Cubic, true) => {
+                const $k: usize = 4;
+                const $n: usize = 16;
+                $body
+            }
+            ($crate::particle::stencil::Kernel::Cubic, false) => {
+                const $k: usize = 4;
+                const $n: usize = 64;
+                $body
+            }
+        }
+    };
+}
+pub(crate) use with_nodes;
+
 /// The offsets `o_a` of every node as scalars, per axis (`N = K^d` nodes, as [`Nodes`]).
 #[inline(always)]
 pub(crate) fn node_offsets<T: Real, const D: usize, const K: usize, const N: usize>() -> [[T; N]; D]

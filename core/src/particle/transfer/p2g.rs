@@ -11,7 +11,7 @@
 //! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
 //! node loop is per particle.
 
-use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint};
+use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
 use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
@@ -305,12 +305,7 @@ where
     unsafe fn finish(&mut self, i: usize, pre: &Pre<T, D>, tau_dev: Mat<T, D>) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => match self.args.kernel {
-                Kernel::Quadratic if D == 2 => self.scatter::<3, 9>(&r),
-                Kernel::Quadratic => self.scatter::<3, 27>(&r),
-                Kernel::Cubic if D == 2 => self.scatter::<4, 16>(&r),
-                Kernel::Cubic => self.scatter::<4, 64>(&r),
-            },
+            Ok(r) => with_nodes!(self.args.kernel, D, |K, N| self.scatter::<K, N>(&r)),
         };
         self.first.note(i, r);
     }
