@@ -24,7 +24,7 @@ use super::prepared::{self, MAX_LEN};
 use super::{ahat, chat_z, evaluate, psd_block, Dim, LaneDim};
 use crate::error::Error;
 use crate::lane::lmat::all_finite;
-use crate::lane::{Isa, IsaKind, Lane};
+use crate::lane::{Isa, IsaKind, Lane, X2};
 use crate::scalar::Real;
 use core::ptr;
 
@@ -63,18 +63,32 @@ mod sealed {
         type Avx2: crate::lane::Lane<Scalar = Self>;
         #[cfg(target_arch = "x86_64")]
         type Avx512: crate::lane::Lane<Scalar = Self>;
+        /// Eight lanes on AVX2 (short per-node vectors, see [`super::LaneOp::run_rows`]).
+        #[cfg(target_arch = "x86_64")]
+        type Avx2Row: crate::lane::Lane<Scalar = Self>;
+        /// Eight lanes on AVX-512.
+        #[cfg(target_arch = "x86_64")]
+        type Avx512Row: crate::lane::Lane<Scalar = Self>;
     }
     impl Sealed for f32 {
         #[cfg(target_arch = "x86_64")]
         type Avx2 = crate::lane::X2<crate::lane::F32x8>;
         #[cfg(target_arch = "x86_64")]
         type Avx512 = crate::lane::X2<crate::lane::F32x16>;
+        #[cfg(target_arch = "x86_64")]
+        type Avx2Row = crate::lane::F32x8;
+        #[cfg(target_arch = "x86_64")]
+        type Avx512Row = crate::lane::F32x8;
     }
     impl Sealed for f64 {
         #[cfg(target_arch = "x86_64")]
         type Avx2 = crate::lane::X2<crate::lane::F64x4>;
         #[cfg(target_arch = "x86_64")]
         type Avx512 = crate::lane::X2<crate::lane::F64x8>;
+        #[cfg(target_arch = "x86_64")]
+        type Avx2Row = crate::lane::X2<crate::lane::F64x4>;
+        #[cfg(target_arch = "x86_64")]
+        type Avx512Row = crate::lane::F64x8;
     }
 }
 
@@ -82,25 +96,35 @@ mod sealed {
 pub(crate) trait LaneOp<T> {
     /// Runs the loop on lanes `V`.
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus;
+
+    /// Runs the loop on lanes `V`, with `R` a lane type of exactly eight lanes of the same
+    /// instruction set for short per-item vectors (e.g. the sums of one node).
+    #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        self.run::<V>()
+    }
 }
+
+/// Eight scalar lanes (the row type of the scalar path).
+pub(crate) type ScalarRow<T> = X2<X2<X2<T>>>;
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
 unsafe fn run_avx2<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
-    op.run::<T::Avx2>()
+    op.run_rows::<T::Avx2, T::Avx2Row>()
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
 unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
-    op.run::<T::Avx512>()
+    op.run_rows::<T::Avx512, T::Avx512Row>()
 }
 
 /// Runs `op` on the lanes of `isa`.
 #[inline]
 pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> BatchStatus {
     match isa.kind() {
-        IsaKind::Scalar => op.run::<T>(),
+        IsaKind::Scalar => op.run_rows::<T, ScalarRow<T>>(),
         #[cfg(target_arch = "x86_64")]
         // SAFETY: an `Isa` other than scalar certifies the CPU's support (see `Isa`).
         IsaKind::Avx2 => unsafe { run_avx2::<T, O>(op) },
@@ -108,7 +132,7 @@ pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> Batc
         // SAFETY: as above.
         IsaKind::Avx512 => unsafe { run_avx512::<T, O>(op) },
         #[cfg(not(target_arch = "x86_64"))]
-        _ => op.run::<T>(),
+        _ => op.run_rows::<T, ScalarRow<T>>(),
     }
 }
 

@@ -8,11 +8,11 @@
 //! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
-use super::nodes::{add, nodes, read, rel_base, restore, table, with_nodes};
+use super::nodes::{add, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::LMat;
@@ -271,7 +271,25 @@ where
 {
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // `dispatch` calls `run_rows`; this is its scalar-row form.
+        self.run_rows::<V, ScalarRow<T>>()
+    }
+
+    #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        with_nodes!(self.kernel, D, |K, N| self.run_nodes::<R, K, N>())
+    }
+}
+
+impl<T: BatchReal, const D: usize> ApplyOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    #[inline(always)]
+    fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let sl = slot_len(D);
+        let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
         let (kernel, h, view) = (self.kernel, self.h, self.view);
         for i in 0..self.n {
@@ -282,9 +300,7 @@ where
                     Err(Error::NotPrepared)
                 } else {
                     let xp = rd_vec::<T, D>(self.x, i);
-                    with_nodes!(kernel, D, |K, N| one::<T, D, K, N>(
-                        kernel, h, &xp, slot, view
-                    ))
+                    one::<T, R, D, K, N>(kernel, h, &xp, slot, view, &cst)
                 }
             };
             first.note(i, r);
@@ -296,12 +312,13 @@ where
 /// One particle of [`apply`]: `G = Σ_j δu_j ∇w_jᵀ` over the nodes in order, `M = 𝒜(G)`, then
 /// `δf_i = M ∇w_i` added per channel, with every old value kept and put back on overflow.
 #[inline(always)]
-unsafe fn one<T: Real, const D: usize, const K: usize, const N: usize>(
+unsafe fn one<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
     kernel: Kernel,
     h: T,
     x: &[T; D],
     slot: &[T],
     view: &ForceView<T, D>,
+    cst: &[[T; 8]; N],
 ) -> Result<()>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -317,15 +334,23 @@ where
     if !chk {
         return Err(Error::NonFinite);
     }
-    let nd = nodes::<T, D, K, N>(&s);
-    let mut g = Mat::<T, D>::ZERO;
-    for i in 0..N {
+    // G row by row: lanes 1 + d + b of Σ_j δu_{a,j} m_j are Σ_j δu_{a,j} ∂w_j/∂x_b.
+    let m = rows::<T, R, D, K, N>(&s, cst);
+    let mut sum = [R::splat(T::ZERO); D];
+    for j in 0..N {
         for a in 0..D {
-            for b in 0..D {
-                g.cols[b][a] += u[a][i] * nd.g[b][i];
-            }
+            sum[a] += R::splat(u[a][j]) * m[j];
         }
     }
+    let mut g = Mat::<T, D>::ZERO;
+    for a in 0..D {
+        let mut l = [T::ZERO; 8];
+        sum[a].store(&mut l);
+        for b in 0..D {
+            g.cols[b][a] = l[1 + D + b];
+        }
+    }
+    let nd = nodes::<T, D, K, N>(&s);
     let m = apply_slot(slot, &g);
     let mut f = [[T::ZERO; N]; D];
     for i in 0..N {

@@ -10,10 +10,10 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{node_offsets, nodes, read, rel_base, table, taint, with_nodes, Nodes};
+use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes};
 use super::{BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
@@ -126,17 +126,37 @@ where
 {
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // `dispatch` calls `run_rows`; this is its scalar-row form.
+        self.run_rows::<V, ScalarRow<T>>()
+    }
+
+    #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<R, K, N>())
+    }
+}
+
+impl<T: BatchReal, const D: usize> G2pOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    #[inline(always)]
+    fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
+        let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
         for i in 0..self.n {
             // SAFETY: `g2p_update`'s contract.
             let r = unsafe {
-                one(
+                one::<T, R, D, K, N>(
                     self.material,
                     &self.checked,
                     self.args,
                     self.ps,
                     self.view,
                     self.faces,
+                    &cst,
                     i,
                 )
             };
@@ -146,14 +166,16 @@ where
     }
 }
 
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
-unsafe fn one<T: Real, const D: usize>(
+unsafe fn one<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
     material: &Material<T>,
     checked: &Checked,
     args: &G2pArgs<T>,
     ps: &Particles<T>,
     view: &G2pView<T, D>,
     faces: Option<&[G2pView<T, D>; D]>,
+    cst: &[[T; 8]; N],
     i: usize,
 ) -> Result<()>
 where
@@ -167,9 +189,7 @@ where
     };
     let p = ps.get::<D>(i, reads, material)?;
     checked.for_phase(p.phase)?;
-    let sample = with_nodes!(args.kernel, D, |K, N| sample::<T, D, K, N>(
-        material, args, &p.x, view, faces
-    ))?;
+    let sample = sample::<T, R, D, K, N>(material, args, &p.x, view, faces, cst)?;
     // The material was validated for this phase above (`checked`).
     let (out, _) = update_validated(material, args.dt, &sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
@@ -183,45 +203,44 @@ where
 /// Sums over the velocity channels of one stencil (components `comps`): per component
 /// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite. The sums run
 /// over the nodes in order; the `1 + 2d` sums of a component are one short vector
-/// (`[w v, w v o₀…, v ∂w/∂x₀…] += [w v, …, v, …] ⊙ [1, o₀…, ∂w/∂x₀…]`, the same roundings as
-/// summing each on its own).
+/// `Σ_i v_i m_i` over the node rows `m` of [`rows`].
 #[inline(always)]
-unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
-    nd: &Nodes<T, D, N>,
+unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+    m: &[R; N],
     rel: &[isize; D],
     ch: &[InChannel<T, D>; D],
     comps: (usize, usize),
 ) -> ([T; D], [[T; D]; D], [[T; D]; D], bool) {
     let mut q = [[T::ZERO; N]; D];
     let mut chk = true;
-    for a in comps.0..comps.1 {
+    // Loops over all `d` components with a test (a fixed trip count the compiler unrolls).
+    let on = |a: usize| comps.0 <= a && a < comps.1;
+    for a in 0..D {
+        if !on(a) {
+            continue;
+        }
         let t = table(&ch[a], rel);
         chk &= read::<T, D, K, N>(ch[a].data, &t, ch[a].stride[0], &mut q[a]);
     }
-    let oc = node_offsets::<T, D, K, N>();
-    let mut acc = [[T::ZERO; 8]; D];
+    let mut sum = [R::splat(T::ZERO); D];
     for i in 0..N {
-        let mut rt = [T::ZERO; 8];
-        rt[0] = T::ONE;
-        for b in 0..D {
-            rt[1 + b] = oc[b][i];
-            rt[1 + D + b] = nd.g[b][i];
-        }
-        for a in comps.0..comps.1 {
-            let wq = nd.w[i] * q[a][i];
-            let mut lt = [T::ZERO; 8];
-            for (k, l) in lt.iter_mut().enumerate() {
-                *l = if k <= D { wq } else { q[a][i] };
-            }
-            for k in 0..8 {
-                acc[a][k] += lt[k] * rt[k];
+        for a in 0..D {
+            if on(a) {
+                sum[a] += R::splat(q[a][i]) * m[i];
             }
         }
+    }
+    let mut acc = [[T::ZERO; 8]; D];
+    for a in 0..D {
+        sum[a].store(&mut acc[a]);
     }
     let mut v = [T::ZERO; D];
     let mut so = [[T::ZERO; D]; D];
     let mut g = [[T::ZERO; D]; D];
-    for a in comps.0..comps.1 {
+    for a in 0..D {
+        if !on(a) {
+            continue;
+        }
         v[a] = acc[a][0];
         for b in 0..D {
             so[a][b] = acc[a][1 + b];
@@ -232,10 +251,17 @@ unsafe fn sums<T: Real, const D: usize, const K: usize, const N: usize>(
 }
 
 /// `Σ w Tⁿ⁺¹` and `Σ w (Tⁿ⁺¹ − Tⁿ)` (the node difference is exact when the two are within a
-/// factor 2, Sterbenz), and whether every value read was finite.
+/// factor 2, Sterbenz), and whether every value read was finite; `w` is column 0 of the node
+/// rows `m` of [`rows`].
 #[inline(always)]
-unsafe fn temperatures<T: Real, const D: usize, const K: usize, const N: usize>(
-    nd: &Nodes<T, D, N>,
+unsafe fn temperatures<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const N: usize,
+>(
+    m: &[R; N],
     rel: &[isize; D],
     new: &InChannel<T, D>,
     old: &InChannel<T, D>,
@@ -243,22 +269,30 @@ unsafe fn temperatures<T: Real, const D: usize, const K: usize, const N: usize>(
     let (mut tn, mut to) = ([T::ZERO; N], [T::ZERO; N]);
     let mut chk = read::<T, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
     chk &= read::<T, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
+    // Lane 0 of each row is the weight: lane 0 sums Σ w Tⁿ⁺¹, lane 1 Σ w (Tⁿ⁺¹ − Tⁿ).
+    let mut w = [T::ZERO; N];
+    for i in 0..N {
+        let mut l = [T::ZERO; 8];
+        m[i].store(&mut l);
+        w[i] = l[0];
+    }
     let (mut pic, mut flip) = (T::ZERO, T::ZERO);
     for i in 0..N {
-        pic += nd.w[i] * tn[i];
-        flip += nd.w[i] * (tn[i] - to[i]);
+        pic += w[i] * tn[i];
+        flip += w[i] * (tn[i] - to[i]);
     }
     (pic, flip, chk)
 }
 
 /// The grid sample of a particle at `x`.
 #[inline(always)]
-unsafe fn sample<T: Real, const D: usize, const K: usize, const N: usize>(
+unsafe fn sample<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
     material: &Material<T>,
     args: &G2pArgs<T>,
     x: &[T; D],
     view: &G2pView<T, D>,
     faces: Option<&[G2pView<T, D>; D]>,
+    cst: &[[T; 8]; N],
 ) -> Result<G2pSample<T, D>>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -291,10 +325,10 @@ where
         }
     };
     // The collocated stencil's nodes, once for its velocities and temperatures.
-    let nd = nodes::<T, D, K, N>(&s);
+    let m = rows::<T, R, D, K, N>(&s, cst);
     match faces {
         None => {
-            let (v, so, g, ok) = sums::<T, D, K, N>(&nd, &rel, &view.velocity, (0, D));
+            let (v, so, g, ok) = sums::<T, R, D, K, N>(&m, &rel, &view.velocity, (0, D));
             finite &= ok;
             for a in 0..D {
                 put(a, &s, &v, &so, &g);
@@ -304,8 +338,8 @@ where
             for a in 0..D {
                 let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
                 let rl = rel_base(&st, &f[a].nodes)?;
-                let nf = nodes::<T, D, K, N>(&st);
-                let (v, so, g, ok) = sums::<T, D, K, N>(&nf, &rl, &f[a].velocity, (a, a + 1));
+                let mf = rows::<T, R, D, K, N>(&st, cst);
+                let (v, so, g, ok) = sums::<T, R, D, K, N>(&mf, &rl, &f[a].velocity, (a, a + 1));
                 finite &= ok;
                 put(a, &st, &v, &so, &g);
             }
@@ -313,7 +347,7 @@ where
     }
     if material.heat.is_some() {
         let (pic, flip, ok) =
-            temperatures::<T, D, K, N>(&nd, &rel, &view.temperature, &view.temperature_old);
+            temperatures::<T, R, D, K, N>(&m, &rel, &view.temperature, &view.temperature_old);
         finite &= ok;
         out.t_pic = pic;
         out.t_flip = flip;

@@ -2,6 +2,7 @@
 
 use super::{Channel, NodeBox};
 use crate::error::{Error, Result};
+use crate::lane::Lane;
 use crate::particle::stencil::Stencil;
 use crate::scalar::Real;
 use core::mem::MaybeUninit;
@@ -54,10 +55,11 @@ pub(crate) fn taint<T: Real>(ok: &mut bool, x: T) {
 }
 
 /// The nodes of a stencil as arrays over the node index `i = Σ_a o_a K^a` (axis 0 fastest,
-/// `N = K^d` nodes): weights and weight gradients (1/m), with the products of
-/// [`Stencil::node`] in its order (`w = w₀·w₁·w₂` left to right; `∂w/∂x_a = dw_a` times the
-/// other axes' weights in axis order). Arrays over nodes let the per-node arithmetic of a
-/// particle run on SIMD lanes.
+/// `N = K^d` nodes): weights and weight gradients (1/m). Formed row by row (a row is the `K`
+/// nodes that differ in axis 0 only): with `c = w₁·w₂` (the other axes' weights, in axis
+/// order) and `c_a` the same product with `dw_a` in place of `w_a`, `w = w₀·c`,
+/// `∂w/∂x₀ = dw₀·c`, `∂w/∂x_a = w₀·c_a` (`a ≥ 1`). Arrays over nodes let the per-node
+/// arithmetic of a particle run on SIMD lanes.
 pub(crate) struct Nodes<T, const D: usize, const N: usize> {
     /// Weights.
     pub w: [T; N],
@@ -76,24 +78,90 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
         g: [[T::ZERO; N]; D],
     };
     let (w, dw) = (&s.w, &s.dw);
-    for r in 0..N {
-        let o = Offsets::<D, K, N>::O[r];
-        let mut wt = w[0][o[0]];
+    for r in 0..N / K {
+        let o = Offsets::<D, K, N>::O[r * K];
+        // c[0]: the product of the weights of axes 1.. ; c[a]: with dw_a for w_a.
+        let mut c = [T::ONE; D];
         for a in 1..D {
-            wt *= w[a][o[a]];
-        }
-        for a in 0..D {
-            let mut p = dw[a][o[a]];
-            for b in 0..D {
-                if b != a {
-                    p *= w[b][o[b]];
-                }
+            for (b, cb) in c.iter_mut().enumerate() {
+                *cb *= if b == a { dw[a][o[a]] } else { w[a][o[a]] };
             }
-            nd.g[a][r] = p;
         }
-        nd.w[r] = wt;
+        for o0 in 0..K {
+            let i = r * K + o0;
+            nd.w[i] = w[0][o0] * c[0];
+            nd.g[0][i] = dw[0][o0] * c[0];
+            for a in 1..D {
+                nd.g[a][i] = w[0][o0] * c[a];
+            }
+        }
     }
     nd
+}
+
+/// The node rows of a stencil for sums over its nodes, as eight-lane vectors `R`:
+/// `m_i = [w, w o₀, …, w o_{d−1}, ∂w/∂x₀, …, ∂w/∂x_{d−1}, 0…]` for node `i` (the products
+/// of [`Nodes`]; `w o` is exact for the offsets 0, 1, 2 of the quadratic kernel).
+/// `Σ_i v_i m_i` then gives the `1 + 2d` sums of a node value `v` with one vector
+/// multiply-add per node. Each row is the product of a factor of its axis-0 offset, one of
+/// its stencil row and a constant of [`row_consts`] (`cst`), so no value moves between lanes.
+#[inline(always)]
+pub(crate) fn rows<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+    cst: &[[T; 8]; N],
+) -> [R; N] {
+    debug_assert_eq!(R::LANES, 8);
+    let (w, dw) = (&s.w, &s.dw);
+    // Per axis-0 offset: [w₀, w₀…, dw₀, w₀…, 0…].
+    let mut f0 = [R::splat(T::ZERO); K];
+    for (o0, f) in f0.iter_mut().enumerate() {
+        let mut l = [T::ZERO; 8];
+        l[0] = w[0][o0];
+        for b in 0..D {
+            l[1 + b] = w[0][o0];
+            l[1 + D + b] = if b == 0 { dw[0][o0] } else { w[0][o0] };
+        }
+        *f = R::load(&l);
+    }
+    let mut m = [R::splat(T::ZERO); N];
+    for r in 0..N / K {
+        let o = Offsets::<D, K, N>::O[r * K];
+        // c[0]: the product of the weights of axes 1.. ; c[a]: with dw_a for w_a.
+        let mut c = [T::ONE; D];
+        for a in 1..D {
+            for (b, cb) in c.iter_mut().enumerate() {
+                *cb *= if b == a { dw[a][o[a]] } else { w[a][o[a]] };
+            }
+        }
+        let mut l = [T::ZERO; 8];
+        l[0] = c[0];
+        for b in 0..D {
+            l[1 + b] = c[0];
+            l[1 + D + b] = if b == 0 { c[0] } else { c[b] };
+        }
+        let fr = R::load(&l);
+        for o0 in 0..K {
+            let i = r * K + o0;
+            m[i] = f0[o0] * fr * R::load(&cst[i]);
+        }
+    }
+    m
+}
+
+/// The constant factors of [`rows`]: `[1, o₀, …, o_{d−1}, 1…, 0…]` per node.
+#[inline(always)]
+pub(crate) fn row_consts<T: Real, const D: usize, const K: usize, const N: usize>() -> [[T; 8]; N] {
+    let c = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
+    let mut m = [[T::ZERO; 8]; N];
+    for (i, mi) in m.iter_mut().enumerate() {
+        let o = Offsets::<D, K, N>::O[i];
+        mi[0] = T::ONE;
+        for a in 0..D {
+            mi[1 + a] = c[o[a]];
+            mi[1 + D + a] = T::ONE;
+        }
+    }
+    m
 }
 
 /// Evaluates `body` with the constants `K` (nodes per axis of `kernel`) and `N = K^d` (nodes
@@ -172,7 +240,9 @@ pub(crate) fn row_off<const D: usize, const K: usize, const N: usize>(
 
 /// Reads an input channel at the `N = K^d` stencil nodes into `out` (node order of
 /// [`Nodes`]); `t` from [`table`], `s0` the channel's axis-0 stride. Returns whether every
-/// value read is finite.
+/// value read is finite (tested as read: a separate pass over `out` would reload it with
+/// wider loads than the stores that wrote it, which the store buffer cannot forward). A row
+/// of `K` nodes with `s0 = 1` (separate node arrays) is one contiguous read.
 ///
 /// # Safety
 /// Every stencil node is inside the channel's box (checked by [`rel_base`]).
@@ -186,10 +256,14 @@ pub(crate) unsafe fn read<T: Real, const D: usize, const K: usize, const N: usiz
     let mut ok = true;
     for r in 0..N / K {
         let p = data.offset(row_off::<D, K, N>(t, r));
+        let row: [T; K] = if s0 == 1 {
+            ptr::read_unaligned(p as *const [T; K])
+        } else {
+            core::array::from_fn(|o| ptr::read_unaligned(p.offset(o as isize * s0)))
+        };
         for o in 0..K {
-            let x = ptr::read_unaligned(p.offset(o as isize * s0));
-            taint(&mut ok, x);
-            out[r * K + o] = x;
+            taint(&mut ok, row[o]);
+            out[r * K + o] = row[o];
         }
     }
     ok
@@ -197,7 +271,7 @@ pub(crate) unsafe fn read<T: Real, const D: usize, const K: usize, const N: usiz
 
 /// Adds `val` to an output channel at the `N = K^d` stencil nodes, keeping each old value in
 /// `old`. Returns whether every new value is finite (all are written either way; [`restore`]
-/// puts the old ones back).
+/// puts the old ones back). Rows are contiguous with `s0 = 1`, as in [`read`].
 ///
 /// # Safety
 /// As [`read`], and the channel is valid for writing.
@@ -212,13 +286,23 @@ pub(crate) unsafe fn add<T: Real, const D: usize, const K: usize, const N: usize
     let mut ok = true;
     for r in 0..N / K {
         let p = data.offset(row_off::<D, K, N>(t, r));
+        let x: [T; K] = if s0 == 1 {
+            ptr::read_unaligned(p as *const [T; K])
+        } else {
+            core::array::from_fn(|o| ptr::read_unaligned(p.offset(o as isize * s0)))
+        };
+        let mut nv = x;
         for o in 0..K {
-            let q = p.offset(o as isize * s0);
-            let x = ptr::read_unaligned(q);
-            let nv = x + val[r * K + o];
-            taint(&mut ok, nv);
-            old[r * K + o].write(x);
-            ptr::write_unaligned(q, nv);
+            nv[o] += val[r * K + o];
+            taint(&mut ok, nv[o]);
+            old[r * K + o].write(x[o]);
+        }
+        if s0 == 1 {
+            ptr::write_unaligned(p as *mut [T; K], nv);
+        } else {
+            for o in 0..K {
+                ptr::write_unaligned(p.offset(o as isize * s0), nv[o]);
+            }
         }
     }
     ok

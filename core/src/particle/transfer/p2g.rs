@@ -224,12 +224,16 @@ where
         })
     }
 
-    /// Scatter-adds one particle (`K` nodes per axis, `N = K^d`). The node values of each
-    /// channel are formed as arrays over the nodes, then added channel by channel; every old
-    /// value is kept, and if a new one is not finite the old values are put back (in reverse
-    /// order, so that aliased channels are restored too) and the particle fails.
+    /// Scatter-adds one particle (`K` nodes per axis, `N = K^d`; `oc` from [`node_offsets`]).
+    /// The node values of each channel are formed as an array over the nodes, then added;
+    /// every old value is kept, and if a new one is not finite the old values are put back
+    /// (in reverse order, so that aliased channels are restored too) and the particle fails.
     #[inline(always)]
-    unsafe fn scatter<const K: usize, const N: usize>(&self, r: &Ready<T, D>) -> Result<()> {
+    unsafe fn scatter<const K: usize, const N: usize>(
+        &self,
+        r: &Ready<T, D>,
+        oc: &[[T; N]; D],
+    ) -> Result<()> {
         let v = self.view;
         let rel = rel_base(&r.s, &v.nodes)?;
         let comps: (usize, usize) = match self.args.grid {
@@ -260,37 +264,47 @@ where
             }
         }
         let act = &act[..na];
-        // Node values per channel kind (only the active kinds are read).
         let nd = nodes::<T, D, K, N>(&r.s);
-        let oc = node_offsets::<T, D, K, N>();
         let idt = self.args.impulse_dt;
-        let mut val = [[T::ZERO; N]; CH];
-        for i in 0..N {
-            val[0][i] = nd.w[i] * r.mass;
-        }
-        for a in comps.0..comps.1 {
+        // The force on the nodes along axis `a`.
+        let force = |a: usize| {
+            let mut f = [T::ZERO; N];
             for i in 0..N {
-                let mut f = T::ZERO;
-                let mut q = r.q0[a];
                 for b in 0..D {
-                    f += r.fm.cols[b][a] * nd.g[b][i];
-                    q += r.mch.cols[b][a] * oc[b][i];
-                }
-                val[4 + a][i] = f;
-                val[1 + a][i] = nd.w[i] * q + idt * f;
-            }
-        }
-        if heat_on {
-            for c in 0..3 {
-                for i in 0..N {
-                    val[7 + c][i] = nd.w[i] * r.heat[c];
+                    f[i] += r.fm.cols[b][a] * nd.g[b][i];
                 }
             }
-        }
+            f
+        };
         let mut old = [[MaybeUninit::<T>::uninit(); N]; CH];
         let mut ok = true;
         for (j, (kind, data, t, s0)) in act.iter().enumerate() {
-            ok &= add::<T, D, K, N>(*data, t, *s0, &val[*kind], &mut old[j]);
+            let mut val = [T::ZERO; N];
+            match *kind {
+                0 => {
+                    for i in 0..N {
+                        val[i] = nd.w[i] * r.mass;
+                    }
+                }
+                1..=3 => {
+                    let a = kind - 1;
+                    let f = force(a);
+                    for i in 0..N {
+                        let mut q = r.q0[a];
+                        for b in 0..D {
+                            q += r.mch.cols[b][a] * oc[b][i];
+                        }
+                        val[i] = nd.w[i] * q + idt * f[i];
+                    }
+                }
+                4..=6 => val = force(kind - 4),
+                _ => {
+                    for i in 0..N {
+                        val[i] = nd.w[i] * r.heat[kind - 7];
+                    }
+                }
+            }
+            ok &= add::<T, D, K, N>(*data, t, *s0, &val, &mut old[j]);
         }
         if ok {
             return Ok(());
@@ -302,10 +316,16 @@ where
     }
 
     #[inline(always)]
-    unsafe fn finish(&mut self, i: usize, pre: &Pre<T, D>, tau_dev: Mat<T, D>) {
+    unsafe fn finish<const K: usize, const N: usize>(
+        &mut self,
+        i: usize,
+        pre: &Pre<T, D>,
+        tau_dev: Mat<T, D>,
+        oc: &[[T; N]; D],
+    ) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => with_nodes!(self.args.kernel, D, |K, N| self.scatter::<K, N>(&r)),
+            Ok(r) => self.scatter::<K, N>(&r, oc),
         };
         self.first.note(i, r);
     }
@@ -318,6 +338,19 @@ where
 {
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<V, K, N>())
+    }
+}
+
+impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    #[inline(always)]
+    fn run_nodes<V: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
+        let oc = node_offsets::<T, D, K, N>();
         let lanes = V::LANES;
         let mut start = 0;
         while start < self.n {
@@ -385,7 +418,7 @@ where
                         }
                     }
                     // SAFETY: `p2g`'s contract: valid channels over the box.
-                    unsafe { self.finish(start + l, &pr, tau) };
+                    unsafe { self.finish::<K, N>(start + l, &pr, tau, &oc) };
                 }
             }
             start += len;
