@@ -79,6 +79,17 @@ pub trait Lane:
     /// # Safety
     /// Every such `base.add(i·stride)` is valid for writing; `i·stride < 2³¹`.
     unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32);
+    /// Lanes `0..n` from `p[0..n]`, the others 0 (`n ≤ LANES`).
+    ///
+    /// # Safety
+    /// `p[0..n]` is valid for reading.
+    #[must_use]
+    unsafe fn load_n(p: *const Self::Scalar, n: usize) -> Self;
+    /// Writes lanes `0..n` to `p[0..n]` (`n ≤ LANES`).
+    ///
+    /// # Safety
+    /// `p[0..n]` is valid for writing.
+    unsafe fn store_n(self, p: *mut Self::Scalar, n: usize);
     /// `self·a + b`: fused (one rounding) on the SIMD paths, which all have an FMA
     /// instruction; two roundings on scalars (a software FMA costs ~6 ns without one).
     #[must_use]
@@ -198,6 +209,20 @@ impl<T: Real> Lane for T {
         }
     }
     #[inline(always)]
+    unsafe fn load_n(p: *const T, n: usize) -> T {
+        if n > 0 {
+            p.read_unaligned()
+        } else {
+            T::ZERO
+        }
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut T, n: usize) {
+        if n > 0 {
+            p.write_unaligned(self);
+        }
+    }
+    #[inline(always)]
     fn mul_add(self, a: T, b: T) -> T {
         self * a + b
     }
@@ -306,6 +331,17 @@ impl Isa {
         }
     }
 
+    /// This instruction set, or AVX2 in place of AVX-512 (which implies it): for loops whose
+    /// AVX-512 build is slower than their AVX2 build.
+    #[inline]
+    #[must_use]
+    pub fn at_most_avx2(self) -> Isa {
+        match self.0 {
+            IsaKind::Avx512 => Isa(IsaKind::Avx2),
+            _ => self,
+        }
+    }
+
     /// An [`Isa`] of the given kind without checking the CPU.
     ///
     /// # Safety
@@ -334,7 +370,10 @@ impl Isa {
         {
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 v.push(Isa(IsaKind::Avx2));
-                if std::is_x86_feature_detected!("avx512f") {
+                if std::is_x86_feature_detected!("avx512f")
+                    && std::is_x86_feature_detected!("avx2")
+                    && std::is_x86_feature_detected!("fma")
+                {
                     v.push(Isa(IsaKind::Avx512));
                 }
             }
@@ -443,6 +482,26 @@ impl<V: Lane> Lane for X2<V> {
         self.0[1].scatter(base.add(V::LANES * stride), stride, keep >> V::LANES);
     }
     #[inline(always)]
+    unsafe fn load_n(p: *const Self::Scalar, n: usize) -> Self {
+        if n > V::LANES {
+            X2([
+                V::load_n(p, V::LANES),
+                V::load_n(p.add(V::LANES), n - V::LANES),
+            ])
+        } else {
+            X2([V::load_n(p, n), V::splat(<V::Scalar as Real>::ZERO)])
+        }
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut Self::Scalar, n: usize) {
+        if n > V::LANES {
+            self.0[0].store_n(p, V::LANES);
+            self.0[1].store_n(p.add(V::LANES), n - V::LANES);
+        } else {
+            self.0[0].store_n(p, n);
+        }
+    }
+    #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         X2([
             self.0[0].mul_add(a.0[0], b.0[0]),
@@ -503,5 +562,70 @@ impl<V: Lane> Lane for X2<V> {
     #[inline(always)]
     fn pow2(e: Self) -> Self {
         X2([V::pow2(e.0[0]), V::pow2(e.0[1])])
+    }
+}
+
+#[cfg(all(test, feature = "std"))]
+mod tests {
+    use super::{Lane, X2};
+
+    /// `load_n` reads lanes `0..n` and zeroes the rest; `store_n` writes lanes `0..n` only.
+    fn partial<V: Lane>() {
+        let src: [V::Scalar; 32] = core::array::from_fn(|i| V::Scalar::from_i32(i as i32 + 1));
+        for n in 0..=V::LANES {
+            // SAFETY: `src` holds 32 ≥ LANES scalars.
+            let v = unsafe { V::load_n(src.as_ptr(), n) };
+            let mut all = [V::Scalar::from_i32(-7); 32];
+            v.store(&mut all);
+            for (i, x) in all[..V::LANES].iter().enumerate() {
+                let want = if i < n { src[i] } else { V::Scalar::ZERO };
+                assert_eq!(x.to_f64(), want.to_f64(), "load_n {n} lane {i}");
+            }
+            let mut dst = [V::Scalar::from_i32(-7); 32];
+            // SAFETY: `dst` holds 32 ≥ LANES scalars.
+            unsafe { V::load(&src).store_n(dst.as_mut_ptr(), n) };
+            for (i, x) in dst.iter().enumerate() {
+                let want = if i < n {
+                    src[i]
+                } else {
+                    V::Scalar::from_i32(-7)
+                };
+                assert_eq!(x.to_f64(), want.to_f64(), "store_n {n} lane {i}");
+            }
+        }
+    }
+
+    use crate::scalar::Real;
+
+    #[test]
+    fn partial_loads_and_stores() {
+        partial::<f32>();
+        partial::<X2<X2<X2<f64>>>>();
+        #[cfg(target_arch = "x86_64")]
+        {
+            #[target_feature(enable = "avx2,fma")]
+            unsafe fn avx2() {
+                partial::<super::F32x8>();
+                partial::<super::F64x4>();
+                partial::<X2<super::F32x8>>();
+            }
+            #[target_feature(enable = "avx512f,avx2,fma")]
+            unsafe fn avx512() {
+                partial::<super::F32x16>();
+                partial::<super::F64x8>();
+                partial::<X2<super::F64x8>>();
+            }
+            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+                // SAFETY: the CPU has AVX2 and FMA.
+                unsafe { avx2() };
+            }
+            if std::is_x86_feature_detected!("avx512f")
+                && std::is_x86_feature_detected!("avx2")
+                && std::is_x86_feature_detected!("fma")
+            {
+                // SAFETY: the CPU has AVX-512F, AVX2 and FMA.
+                unsafe { avx512() };
+            }
+        }
     }
 }

@@ -173,6 +173,21 @@ vmask!(
     _mm256_castsi256_ps(_mm256_set1_epi32(-1))
 );
 
+/// The AVX2 mask of lanes `0..n` of eight 32-bit lanes (sign bits set).
+#[inline(always)]
+unsafe fn mask8(n: usize) -> __m256i {
+    _mm256_cmpgt_epi32(
+        _mm256_set1_epi32(n as i32),
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+    )
+}
+
+/// The AVX2 mask of lanes `0..n` of four 64-bit lanes (sign bits set).
+#[inline(always)]
+unsafe fn mask4(n: usize) -> __m256i {
+    _mm256_cmpgt_epi64(_mm256_set1_epi64x(n as i64), _mm256_setr_epi64x(0, 1, 2, 3))
+}
+
 impl Lane for F32x8 {
     type Scalar = f32;
     type Mask = M32x8;
@@ -203,6 +218,14 @@ impl Lane for F32x8 {
             _mm256_set1_epi32(s),
         );
         F32x8(_mm256_i32gather_ps::<4>(base, idx))
+    }
+    #[inline(always)]
+    unsafe fn load_n(p: *const f32, n: usize) -> Self {
+        F32x8(_mm256_maskload_ps(p, mask8(n)))
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut f32, n: usize) {
+        _mm256_maskstore_ps(p, mask8(n), self.0)
     }
     #[inline(always)]
     unsafe fn scatter(self, base: *mut f32, stride: usize, keep: u32) {
@@ -366,6 +389,14 @@ impl Lane for F64x4 {
         let s = stride as i32;
         let idx = _mm_mullo_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(s));
         F64x4(_mm256_i32gather_pd::<8>(base, idx))
+    }
+    #[inline(always)]
+    unsafe fn load_n(p: *const f64, n: usize) -> Self {
+        F64x4(_mm256_maskload_pd(p, mask4(n)))
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut f64, n: usize) {
+        _mm256_maskstore_pd(p, mask4(n), self.0)
     }
     #[inline(always)]
     unsafe fn scatter(self, base: *mut f64, stride: usize, keep: u32) {
@@ -543,6 +574,7 @@ unsafe fn idx8(s: i32) -> __m256i {
 /// Sixteen-lane and eight-lane AVX-512 impls share everything but names and constants.
 macro_rules! avx512_lane {
     ($v:ident, $t:ty, $k:ident, $kraw:ty, $gather:ident, $scatter:ident, $idx:ident, $n:literal, $set1:ident, $loadu:ident, $storeu:ident,
+     $maskz_loadu:ident, $mask_storeu:ident,
      $fmadd:ident, $sqrt:ident, $abs:ident, $cast_i:ident, $cast_f:ident, $and_i:ident,
      $or_i:ident, $andnot_i:ident, $set1_i:ident, $sign:expr, $srli:ident, $sub_i:ident,
      $magic:expr, $rnd:ident, $blend:ident,
@@ -575,6 +607,14 @@ macro_rules! avx512_lane {
                     $idx(stride as i32),
                     base.cast(),
                 ))
+            }
+            #[inline(always)]
+            unsafe fn load_n(p: *const $t, n: usize) -> Self {
+                $v($maskz_loadu(((1u32 << n) - 1) as $kraw, p.cast()))
+            }
+            #[inline(always)]
+            unsafe fn store_n(self, p: *mut $t, n: usize) {
+                $mask_storeu(p.cast(), ((1u32 << n) - 1) as $kraw, self.0)
             }
             #[inline(always)]
             unsafe fn scatter(self, base: *mut $t, stride: usize, keep: u32) {
@@ -684,6 +724,8 @@ avx512_lane!(
     _mm512_set1_ps,
     _mm512_loadu_ps,
     _mm512_storeu_ps,
+    _mm512_maskz_loadu_ps,
+    _mm512_mask_storeu_ps,
     _mm512_fmadd_ps,
     _mm512_sqrt_ps,
     _mm512_abs_ps,
@@ -732,6 +774,8 @@ avx512_lane!(
     _mm512_set1_pd,
     _mm512_loadu_pd,
     _mm512_storeu_pd,
+    _mm512_maskz_loadu_pd,
+    _mm512_mask_storeu_pd,
     _mm512_fmadd_pd,
     _mm512_sqrt_pd,
     _mm512_abs_pd,

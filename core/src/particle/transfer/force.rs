@@ -329,7 +329,7 @@ where
     let mut chk = true;
     for a in 0..D {
         let c = &view.du[a];
-        chk &= read::<T, D, K, N>(c.data, &table(c, &rel), c.stride[0], &mut u[a]);
+        chk &= read::<T, R, D, K, N>(c.data, &table(c, &rel), c.stride[0], &mut u[a]);
     }
     if !chk {
         return Err(Error::NonFinite);
@@ -365,7 +365,7 @@ where
     for a in 0..D {
         let c = &view.df[a];
         tabs[a] = table(c, &rel);
-        chk &= add::<T, D, K, N>(c.data, &tabs[a], c.stride[0], &f[a], &mut old[a]);
+        chk &= add::<T, R, D, K, N>(c.data, &tabs[a], c.stride[0], &f[a], &mut old[a]);
     }
     if !chk {
         for a in (0..D).rev() {

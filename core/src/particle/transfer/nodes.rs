@@ -247,13 +247,28 @@ pub(crate) fn row_off<const D: usize, const K: usize, const N: usize>(
 /// # Safety
 /// Every stencil node is inside the channel's box (checked by [`rel_base`]).
 #[inline(always)]
-pub(crate) unsafe fn read<T: Real, const D: usize, const K: usize, const N: usize>(
+pub(crate) unsafe fn read<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const N: usize,
+>(
     data: *const T,
     t: &[[isize; 4]; D],
     s0: isize,
     out: &mut [T; N],
 ) -> bool {
     let mut ok = true;
+    if s0 == 1 && K <= R::LANES {
+        // A row as one partial vector.
+        for r in 0..N / K {
+            let row = R::load_n(data.offset(row_off::<D, K, N>(t, r)), K);
+            ok &= R::all(row.is_finite());
+            row.store_n(out.as_mut_ptr().add(r * K), K);
+        }
+        return ok;
+    }
     for r in 0..N / K {
         let p = data.offset(row_off::<D, K, N>(t, r));
         let row: [T; K] = if s0 == 1 {
@@ -276,7 +291,13 @@ pub(crate) unsafe fn read<T: Real, const D: usize, const K: usize, const N: usiz
 /// # Safety
 /// As [`read`], and the channel is valid for writing.
 #[inline(always)]
-pub(crate) unsafe fn add<T: Real, const D: usize, const K: usize, const N: usize>(
+pub(crate) unsafe fn add<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const N: usize,
+>(
     data: *mut T,
     t: &[[isize; 4]; D],
     s0: isize,
@@ -284,6 +305,18 @@ pub(crate) unsafe fn add<T: Real, const D: usize, const K: usize, const N: usize
     old: &mut [MaybeUninit<T>; N],
 ) -> bool {
     let mut ok = true;
+    if s0 == 1 && K <= R::LANES {
+        // A row as one partial vector (lanes `K..` are 0 in both terms, so finite).
+        for r in 0..N / K {
+            let p = data.offset(row_off::<D, K, N>(t, r));
+            let x = R::load_n(p, K);
+            let nv = x + R::load_n(val.as_ptr().add(r * K), K);
+            ok &= R::all(nv.is_finite());
+            x.store_n(old.as_mut_ptr().add(r * K).cast::<T>(), K);
+            nv.store_n(p, K);
+        }
+        return ok;
+    }
     for r in 0..N / K {
         let p = data.offset(row_off::<D, K, N>(t, r));
         let x: [T; K] = if s0 == 1 {

@@ -14,7 +14,7 @@
 use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
 use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp, MAX_LANES};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
@@ -229,7 +229,7 @@ where
     /// every old value is kept, and if a new one is not finite the old values are put back
     /// (in reverse order, so that aliased channels are restored too) and the particle fails.
     #[inline(always)]
-    unsafe fn scatter<const K: usize, const N: usize>(
+    unsafe fn scatter<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
         r: &Ready<T, D>,
         oc: &[[T; N]; D],
@@ -304,7 +304,7 @@ where
                     }
                 }
             }
-            ok &= add::<T, D, K, N>(*data, t, *s0, &val, &mut old[j]);
+            ok &= add::<T, R, D, K, N>(*data, t, *s0, &val, &mut old[j]);
         }
         if ok {
             return Ok(());
@@ -316,7 +316,7 @@ where
     }
 
     #[inline(always)]
-    unsafe fn finish<const K: usize, const N: usize>(
+    unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
         pre: &Pre<T, D>,
@@ -325,7 +325,7 @@ where
     ) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => self.scatter::<K, N>(&r, oc),
+            Ok(r) => self.scatter::<R, K, N>(&r, oc),
         };
         self.first.note(i, r);
     }
@@ -338,7 +338,13 @@ where
 {
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<V, K, N>())
+        // `dispatch` calls `run_rows`; this is its scalar-row form.
+        self.run_rows::<V, ScalarRow<T>>()
+    }
+
+    #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<V, R, K, N>())
     }
 }
 
@@ -349,7 +355,9 @@ where
 {
     /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
     #[inline(always)]
-    fn run_nodes<V: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
+    fn run_nodes<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+    ) -> BatchStatus {
         let oc = node_offsets::<T, D, K, N>();
         let lanes = V::LANES;
         let mut start = 0;
@@ -418,7 +426,7 @@ where
                         }
                     }
                     // SAFETY: `p2g`'s contract: valid channels over the box.
-                    unsafe { self.finish::<K, N>(start + l, &pr, tau, &oc) };
+                    unsafe { self.finish::<R, K, N>(start + l, &pr, tau, &oc) };
                 }
             }
             start += len;
