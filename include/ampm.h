@@ -2874,7 +2874,8 @@ AmpmStatus ampm_pressure_3d_f64(const AmpmMaterial_f64 *material,
 
 /**
  * Chooses the instruction set of every batch call (`AMPM_ISA_*`); by default the widest the
- * CPU supports, detected on first use.
+ * CPU supports, detected on first use. Under `AMPM_ISA_AVX512` the G2P calls
+ * (`ampm_g2p_update_*`) run their AVX2 code, which is faster for them.
  *
  * Returns `AMPM_ERR_INVALID_ARGUMENT` (and changes nothing) for a value this CPU does not
  * support. Results are identical on the AVX2 and AVX-512 paths; the scalar path agrees with

@@ -18,7 +18,8 @@ pub const AMPM_ISA_AVX2: u32 = 1;
 pub const AMPM_ISA_AVX512: u32 = 2;
 
 /// Chooses the instruction set of every batch call (`AMPM_ISA_*`); by default the widest the
-/// CPU supports, detected on first use.
+/// CPU supports, detected on first use. Under `AMPM_ISA_AVX512` the G2P calls
+/// (`ampm_g2p_update_*`) run their AVX2 code, which is faster for them.
 ///
 /// Returns `AMPM_ERR_INVALID_ARGUMENT` (and changes nothing) for a value this CPU does not
 /// support. Results are identical on the AVX2 and AVX-512 paths; the scalar path agrees with
