@@ -1,0 +1,369 @@
+//! AVX2 + FMA lanes: `f32×8`, `f64×4` (see the parent module for the safety argument).
+
+#![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
+
+use super::super::Lane;
+use core::arch::x86_64::*;
+use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
+
+/// Eight `f32` lanes (AVX2 + FMA).
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct F32x8(__m256);
+arith!(
+    F32x8,
+    _mm256_add_ps,
+    _mm256_sub_ps,
+    _mm256_mul_ps,
+    _mm256_div_ps,
+    _mm256_xor_ps,
+    _mm256_set1_ps,
+    -0.0f32
+);
+vmask!(
+    M32x8,
+    __m256,
+    _mm256_and_ps,
+    _mm256_or_ps,
+    _mm256_xor_ps,
+    _mm256_castsi256_ps(_mm256_set1_epi32(-1))
+);
+
+/// The AVX2 mask of lanes `0..n` of eight 32-bit lanes (sign bits set).
+#[inline(always)]
+unsafe fn mask8(n: usize) -> __m256i {
+    _mm256_cmpgt_epi32(
+        _mm256_set1_epi32(n as i32),
+        _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+    )
+}
+
+/// The AVX2 mask of lanes `0..n` of four 64-bit lanes (sign bits set).
+#[inline(always)]
+unsafe fn mask4(n: usize) -> __m256i {
+    _mm256_cmpgt_epi64(_mm256_set1_epi64x(n as i64), _mm256_setr_epi64x(0, 1, 2, 3))
+}
+
+impl Lane for F32x8 {
+    type Scalar = f32;
+    type Mask = M32x8;
+    const LANES: usize = 8;
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(_mm256_set1_ps(x)) }
+    }
+    #[inline(always)]
+    fn load(s: &[f32]) -> Self {
+        let s = &s[..8];
+        // SAFETY: `s` holds 8 scalars; unaligned load.
+        unsafe { F32x8(_mm256_loadu_ps(s.as_ptr())) }
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [f32]) {
+        let s = &mut s[..8];
+        // SAFETY: `s` holds 8 scalars; unaligned store.
+        unsafe { _mm256_storeu_ps(s.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    unsafe fn gather(base: *const f32, stride: usize) -> Self {
+        let s = stride as i32;
+        let idx = _mm256_mullo_epi32(
+            _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
+            _mm256_set1_epi32(s),
+        );
+        F32x8(_mm256_i32gather_ps::<4>(base, idx))
+    }
+    #[inline(always)]
+    unsafe fn load_n(p: *const f32, n: usize) -> Self {
+        F32x8(_mm256_maskload_ps(p, mask8(n)))
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut f32, n: usize) {
+        _mm256_maskstore_ps(p, mask8(n), self.0)
+    }
+    #[inline(always)]
+    unsafe fn scatter(self, base: *mut f32, stride: usize, keep: u32) {
+        let mut b = [0.0f32; 8];
+        _mm256_storeu_ps(b.as_mut_ptr(), self.0);
+        for (i, x) in b.iter().enumerate() {
+            if keep >> i & 1 == 1 {
+                base.add(i * stride).write_unaligned(*x);
+            }
+        }
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        // SAFETY: see the module docs (FMA is part of the AVX2 path).
+        unsafe { F32x8(_mm256_fmadd_ps(self.0, a.0, b.0)) }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(_mm256_sqrt_ps(self.0)) }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)) }
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe {
+            let m = _mm256_set1_ps(-0.0);
+            F32x8(_mm256_or_ps(
+                _mm256_andnot_ps(m, self.0),
+                _mm256_and_ps(m, sign.0),
+            ))
+        }
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(_mm256_floor_ps(self.0)) }
+    }
+    #[inline(always)]
+    fn rsqrt_guess(self) -> Self {
+        // SAFETY: see the module docs. As `Real::rsqrt_guess`: magic − (bits >> 1).
+        unsafe {
+            let i = _mm256_srli_epi32::<1>(_mm256_castps_si256(self.0));
+            F32x8(_mm256_castsi256_ps(_mm256_sub_epi32(
+                _mm256_set1_epi32(0x5f37_5a86),
+                i,
+            )))
+        }
+    }
+    #[inline(always)]
+    fn select(m: M32x8, a: Self, b: Self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(_mm256_blendv_ps(b.0, a.0, m.0)) }
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M32x8 {
+        // SAFETY: see the module docs.
+        unsafe { M32x8(_mm256_cmp_ps::<_CMP_LT_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M32x8 {
+        // SAFETY: see the module docs.
+        unsafe { M32x8(_mm256_cmp_ps::<_CMP_LE_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M32x8 {
+        // SAFETY: see the module docs.
+        unsafe { M32x8(_mm256_cmp_ps::<_CMP_EQ_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M32x8 {
+        self.abs().lt(Self::splat(f32::INFINITY))
+    }
+    #[inline(always)]
+    fn mask_bits(m: M32x8) -> u32 {
+        // SAFETY: see the module docs.
+        unsafe { _mm256_movemask_ps(m.0) as u32 }
+    }
+    #[inline(always)]
+    fn exponent(self) -> Self {
+        // frexp exponent: biased field − 126; a subnormal is first scaled by 2²³ (exact).
+        let a = self.abs();
+        let sub = a.lt(Self::splat(f32::MIN_POSITIVE));
+        let y = Self::select(sub, a * Self::splat(8_388_608.0), a);
+        // SAFETY: see the module docs.
+        let field = unsafe {
+            F32x8(_mm256_cvtepi32_ps(_mm256_srli_epi32::<23>(
+                _mm256_castps_si256(y.0),
+            )))
+        };
+        let e = field - Self::splat(126.0) - Self::select(sub, Self::splat(23.0), Self::splat(0.0));
+        let special = a.eq(Self::splat(0.0)) | !self.is_finite();
+        Self::select(special, Self::splat(0.0), e)
+    }
+    #[inline(always)]
+    fn pow2(e: Self) -> Self {
+        // SAFETY: see the module docs. `e` is an integer in [−126, 127].
+        unsafe {
+            let i = _mm256_add_epi32(_mm256_cvtps_epi32(e.0), _mm256_set1_epi32(127));
+            F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(i)))
+        }
+    }
+}
+
+/// Four `f64` lanes (AVX2 + FMA).
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct F64x4(__m256d);
+arith!(
+    F64x4,
+    _mm256_add_pd,
+    _mm256_sub_pd,
+    _mm256_mul_pd,
+    _mm256_div_pd,
+    _mm256_xor_pd,
+    _mm256_set1_pd,
+    -0.0f64
+);
+vmask!(
+    M64x4,
+    __m256d,
+    _mm256_and_pd,
+    _mm256_or_pd,
+    _mm256_xor_pd,
+    _mm256_castsi256_pd(_mm256_set1_epi32(-1))
+);
+
+/// `1.5·2⁵²`: adding it to an integer-valued `|e| < 2⁵¹` puts `e` in the low mantissa bits.
+const MAGIC_F64: f64 = 6_755_399_441_055_744.0;
+/// `2⁵²`, whose bits OR-ed with a small integer `m` give the double `2⁵² + m`.
+const TWO52: f64 = 4_503_599_627_370_496.0;
+
+impl Lane for F64x4 {
+    type Scalar = f64;
+    type Mask = M64x4;
+    const LANES: usize = 4;
+
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F64x4(_mm256_set1_pd(x)) }
+    }
+    #[inline(always)]
+    fn load(s: &[f64]) -> Self {
+        let s = &s[..4];
+        // SAFETY: `s` holds 4 scalars; unaligned load.
+        unsafe { F64x4(_mm256_loadu_pd(s.as_ptr())) }
+    }
+    #[inline(always)]
+    fn store(self, s: &mut [f64]) {
+        let s = &mut s[..4];
+        // SAFETY: `s` holds 4 scalars; unaligned store.
+        unsafe { _mm256_storeu_pd(s.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    unsafe fn gather(base: *const f64, stride: usize) -> Self {
+        let s = stride as i32;
+        let idx = _mm_mullo_epi32(_mm_setr_epi32(0, 1, 2, 3), _mm_set1_epi32(s));
+        F64x4(_mm256_i32gather_pd::<8>(base, idx))
+    }
+    #[inline(always)]
+    unsafe fn load_n(p: *const f64, n: usize) -> Self {
+        F64x4(_mm256_maskload_pd(p, mask4(n)))
+    }
+    #[inline(always)]
+    unsafe fn store_n(self, p: *mut f64, n: usize) {
+        _mm256_maskstore_pd(p, mask4(n), self.0)
+    }
+    #[inline(always)]
+    unsafe fn scatter(self, base: *mut f64, stride: usize, keep: u32) {
+        let mut b = [0.0f64; 4];
+        _mm256_storeu_pd(b.as_mut_ptr(), self.0);
+        for (i, x) in b.iter().enumerate() {
+            if keep >> i & 1 == 1 {
+                base.add(i * stride).write_unaligned(*x);
+            }
+        }
+    }
+    #[inline(always)]
+    fn mul_add(self, a: Self, b: Self) -> Self {
+        // SAFETY: see the module docs (FMA is part of the AVX2 path).
+        unsafe { F64x4(_mm256_fmadd_pd(self.0, a.0, b.0)) }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F64x4(_mm256_sqrt_pd(self.0)) }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F64x4(_mm256_andnot_pd(_mm256_set1_pd(-0.0), self.0)) }
+    }
+    #[inline(always)]
+    fn copysign(self, sign: Self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe {
+            let m = _mm256_set1_pd(-0.0);
+            F64x4(_mm256_or_pd(
+                _mm256_andnot_pd(m, self.0),
+                _mm256_and_pd(m, sign.0),
+            ))
+        }
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F64x4(_mm256_floor_pd(self.0)) }
+    }
+    #[inline(always)]
+    fn rsqrt_guess(self) -> Self {
+        // SAFETY: see the module docs. As `Real::rsqrt_guess`: magic − (bits >> 1).
+        unsafe {
+            let i = _mm256_srli_epi64::<1>(_mm256_castpd_si256(self.0));
+            let m = _mm256_set1_epi64x(0x5fe6_eb50_c7b5_37a9_u64 as i64);
+            F64x4(_mm256_castsi256_pd(_mm256_sub_epi64(m, i)))
+        }
+    }
+    #[inline(always)]
+    fn select(m: M64x4, a: Self, b: Self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F64x4(_mm256_blendv_pd(b.0, a.0, m.0)) }
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M64x4 {
+        // SAFETY: see the module docs.
+        unsafe { M64x4(_mm256_cmp_pd::<_CMP_LT_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M64x4 {
+        // SAFETY: see the module docs.
+        unsafe { M64x4(_mm256_cmp_pd::<_CMP_LE_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn eq(self, o: Self) -> M64x4 {
+        // SAFETY: see the module docs.
+        unsafe { M64x4(_mm256_cmp_pd::<_CMP_EQ_OQ>(self.0, o.0)) }
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M64x4 {
+        self.abs().lt(Self::splat(f64::INFINITY))
+    }
+    #[inline(always)]
+    fn mask_bits(m: M64x4) -> u32 {
+        // SAFETY: see the module docs.
+        unsafe { _mm256_movemask_pd(m.0) as u32 }
+    }
+    #[inline(always)]
+    fn exponent(self) -> Self {
+        // frexp exponent: biased field − 1022; a subnormal is first scaled by 2⁵² (exact). The
+        // 11-bit field becomes a double by OR-ing it into the mantissa of 2⁵².
+        let a = self.abs();
+        let sub = a.lt(Self::splat(f64::MIN_POSITIVE));
+        let y = Self::select(sub, a * Self::splat(TWO52), a);
+        // SAFETY: see the module docs.
+        let field = unsafe {
+            let f = _mm256_srli_epi64::<52>(_mm256_castpd_si256(y.0));
+            let t = _mm256_or_si256(f, _mm256_castpd_si256(_mm256_set1_pd(TWO52)));
+            F64x4(_mm256_castsi256_pd(t)) - Self::splat(TWO52)
+        };
+        let e =
+            field - Self::splat(1022.0) - Self::select(sub, Self::splat(52.0), Self::splat(0.0));
+        let special = a.eq(Self::splat(0.0)) | !self.is_finite();
+        Self::select(special, Self::splat(0.0), e)
+    }
+    #[inline(always)]
+    fn pow2(e: Self) -> Self {
+        // SAFETY: see the module docs. `e` is an integer in [−1022, 1023]: the bits of
+        // `e + 1.5·2⁵²` are those of 1.5·2⁵² plus `e`.
+        unsafe {
+            let t = _mm256_castpd_si256(_mm256_add_pd(e.0, _mm256_set1_pd(MAGIC_F64)));
+            let bias = _mm256_sub_epi64(
+                _mm256_set1_epi64x(1023),
+                _mm256_castpd_si256(_mm256_set1_pd(MAGIC_F64)),
+            );
+            F64x4(_mm256_castsi256_pd(_mm256_slli_epi64::<52>(
+                _mm256_add_epi64(t, bias),
+            )))
+        }
+    }
+}
