@@ -267,15 +267,18 @@ where
         let nd = nodes::<T, D, K, N>(&r.s);
         let idt = self.args.impulse_dt;
         // The force on the nodes along axis `a`.
-        let force = |a: usize| {
-            let mut f = [T::ZERO; N];
+        // The node forces along the written axes, once for the momentum and force channels.
+        let mut force = [[T::ZERO; N]; D];
+        for (a, f) in force.iter_mut().enumerate() {
+            if a < comps.0 || a >= comps.1 {
+                continue;
+            }
             for i in 0..N {
                 for b in 0..D {
                     f[i] += r.fm.cols[b][a] * nd.g[b][i];
                 }
             }
-            f
-        };
+        }
         let mut old = [[MaybeUninit::<T>::uninit(); N]; CH];
         let mut ok = true;
         for (j, (kind, data, t, s0)) in act.iter().enumerate() {
@@ -288,7 +291,7 @@ where
                 }
                 1..=3 => {
                     let a = kind - 1;
-                    let f = force(a);
+                    let f = &force[a];
                     for i in 0..N {
                         let mut q = r.q0[a];
                         for b in 0..D {
@@ -297,7 +300,7 @@ where
                         val[i] = nd.w[i] * q + idt * f[i];
                     }
                 }
-                4..=6 => val = force(kind - 4),
+                4..=6 => val = force[kind - 4],
                 _ => {
                     for i in 0..N {
                         val[i] = nd.w[i] * r.heat[kind - 7];
