@@ -67,6 +67,23 @@ pub(crate) struct Nodes<T, const D: usize, const N: usize> {
     pub g: [[T; N]; D],
 }
 
+/// The factors of stencil row `r` (the nodes `r·K .. r·K + K`): `c[0]` the product of the
+/// weights of axes `1..d` in axis order, `c[a]` (`a ≥ 1`) the same with `dw_a` for `w_a`.
+#[inline(always)]
+fn row_factors<T: Real, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+    r: usize,
+) -> [T; D] {
+    let o = Offsets::<D, K, N>::O[r * K];
+    let mut c = [T::ONE; D];
+    for a in 1..D {
+        for (b, cb) in c.iter_mut().enumerate() {
+            *cb *= if b == a { s.dw[a][o[a]] } else { s.w[a][o[a]] };
+        }
+    }
+    c
+}
+
 /// The [`Nodes`] of a stencil with `K` nodes per axis (`N = K^d`).
 #[inline(always)]
 pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
@@ -79,14 +96,7 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
     };
     let (w, dw) = (&s.w, &s.dw);
     for r in 0..N / K {
-        let o = Offsets::<D, K, N>::O[r * K];
-        // c[0]: the product of the weights of axes 1.. ; c[a]: with dw_a for w_a.
-        let mut c = [T::ONE; D];
-        for a in 1..D {
-            for (b, cb) in c.iter_mut().enumerate() {
-                *cb *= if b == a { dw[a][o[a]] } else { w[a][o[a]] };
-            }
-        }
+        let c = row_factors::<T, D, K, N>(s, r);
         for o0 in 0..K {
             let i = r * K + o0;
             nd.w[i] = w[0][o0] * c[0];
@@ -125,14 +135,7 @@ pub(crate) fn rows<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize,
     }
     let mut m = [R::splat(T::ZERO); N];
     for r in 0..N / K {
-        let o = Offsets::<D, K, N>::O[r * K];
-        // c[0]: the product of the weights of axes 1.. ; c[a]: with dw_a for w_a.
-        let mut c = [T::ONE; D];
-        for a in 1..D {
-            for (b, cb) in c.iter_mut().enumerate() {
-                *cb *= if b == a { dw[a][o[a]] } else { w[a][o[a]] };
-            }
-        }
+        let c = row_factors::<T, D, K, N>(s, r);
         let mut l = [T::ZERO; 8];
         l[0] = c[0];
         for b in 0..D {
