@@ -1323,3 +1323,138 @@ fn unprepared_slots_are_refused() {
         assert_eq!((st.first_failed, st.error), (1, Some(Error::NotPrepared)));
     }
 }
+
+/// Six particles: 0, 1 and 3, 4, 5 around node (6, 6, 6), 2 far away (P2G and apply sum a run
+/// of nearby particles before touching the grid).
+fn runs_of_particles<T: Real, const D: usize>(h: f64) -> Vec<Particle<T, D>> {
+    (0..6)
+        .map(|k| {
+            let c = if k == 2 { 9.0 } else { 5.0 };
+            let x = std::array::from_fn(|a| T::from_f64((c + 0.1 + 0.13 * (k + a) as f64) * h));
+            let mut p = Particle::<T, D>::at_rest(x, T::from_f64(1.0e-3), T::from_f64(1.0e-6));
+            p.v = std::array::from_fn(|a| T::from_f64(0.1 * (a + 1) as f64));
+            p.f_e.cols[0][0] = T::from_f64(1.01 + 0.01 * k as f64);
+            p
+        })
+        .collect()
+}
+
+/// A run whose tile sum is not finite is added one particle at a time: the particles that
+/// overflow (here every stencil of the first cell reaches a NaN node) are refused and write
+/// nothing, the first failure is the lowest index, and the other runs are written.
+#[test]
+fn p2g_run_that_overflows_is_added_one_by_one() {
+    type T = f32;
+    const D: usize = 3;
+    let h = 0.05;
+    let mat = Material::<T>::elastic(10.0, 100.0);
+    let ps = runs_of_particles::<T, D>(h);
+    let args = P2gArgs {
+        kernel: Kernel::Quadratic,
+        grid: Grid::Collocated,
+        h: h as T,
+        impulse_dt: 1.0e-3,
+    };
+    for isa in Isa::available() {
+        let mut g = DenseGrid::<T, D>::new([0; D], [16; D]);
+        // Node (6, 6, 6) is in the stencil of every particle of cell 5 and of none of cell 9.
+        let poisoned = g.index([6; D]);
+        g.ch[MASS][poisoned] = T::NAN;
+        let mut only2 = g.clone();
+        let mut store = Store::from(&ps);
+        // SAFETY: six particles; the channels cover the box.
+        let st = unsafe { p2g::p2g(isa, &mat, &args, 6, &store.raw(), &g.p2g_view()) };
+        assert_eq!(
+            (st.first_failed, st.error),
+            (0, Some(Error::Overflow)),
+            "{isa:?}"
+        );
+        let mut s2 = Store::from(&ps[2..3]);
+        // SAFETY: one particle.
+        let st = unsafe { p2g::p2g(isa, &mat, &args, 1, &s2.raw(), &only2.p2g_view()) };
+        assert_eq!(st.error, None);
+        assert_eq!(
+            g.bits(),
+            only2.bits(),
+            "{isa:?}: only particle 2 was written"
+        );
+        // Without the poisoned node every particle is written, and the NaN velocity of a
+        // later particle does not hide an earlier failure.
+        let mut clean = DenseGrid::<T, D>::new([0; D], [16; D]);
+        let mut bad = ps.clone();
+        bad[4].v[1] = T::NAN;
+        clean.ch[MASS][poisoned] = T::INFINITY;
+        let mut s3 = Store::from(&bad);
+        // SAFETY: six particles.
+        let st = unsafe { p2g::p2g(isa, &mat, &args, 6, &s3.raw(), &clean.p2g_view()) };
+        assert_eq!(
+            (st.first_failed, st.error),
+            (0, Some(Error::Overflow)),
+            "{isa:?}"
+        );
+        clean.ch[MASS][poisoned] = 0.0;
+        let st = unsafe { p2g::p2g(isa, &mat, &args, 6, &s3.raw(), &clean.p2g_view()) };
+        assert_eq!(
+            (st.first_failed, st.error),
+            (4, Some(Error::NonFinite)),
+            "{isa:?}"
+        );
+        let _ = &mut store;
+    }
+}
+
+/// As [`p2g_run_that_overflows_is_added_one_by_one`], for the force differential's apply.
+#[test]
+fn apply_run_that_overflows_is_added_one_by_one() {
+    type T = f64;
+    const D: usize = 3;
+    let h = 0.05;
+    let mat = Material::<T>::elastic(10.0, 100.0);
+    let ps = runs_of_particles::<T, D>(h);
+    let mut store = Store::from(&ps);
+    let mut slots = vec![0.0 as T; 6 * slot_len(D)];
+    for isa in Isa::available() {
+        // SAFETY: six particles, six slots.
+        let st = unsafe { force::prepare::<T, D>(isa, &mat, 6, &store.raw(), slots.as_mut_ptr()) };
+        assert_eq!(st.error, None);
+        let mut du = DenseGrid::<T, D>::new([0; D], [16; D]);
+        for (k, x) in du.ch[MOM].iter_mut().enumerate() {
+            *x = 1.0e-3 * (k % 7) as T;
+        }
+        let mut df = DenseGrid::<T, D>::new([0; D], [16; D]);
+        let poisoned = df.index([6; D]);
+        df.ch[FORCE + 1][poisoned] = T::NAN;
+        let mut only2 = df.clone();
+        let apply = |df: &mut DenseGrid<T, D>, first: usize, n: usize| {
+            let view = ForceView {
+                nodes: du.nodes(),
+                du: std::array::from_fn(|a| du.inp(MOM + a)),
+                df: std::array::from_fn(|a| df.out(FORCE + a)),
+            };
+            // SAFETY: particles first..first + n, their slots; the channels cover the box.
+            unsafe {
+                force::apply::<T, D>(
+                    isa,
+                    Kernel::Quadratic,
+                    h,
+                    n,
+                    store.x.as_ptr().add(first * D),
+                    slots.as_ptr().add(first * slot_len(D)),
+                    &view,
+                )
+            }
+        };
+        let st = apply(&mut df, 0, 6);
+        assert_eq!(
+            (st.first_failed, st.error),
+            (0, Some(Error::Overflow)),
+            "{isa:?}"
+        );
+        assert_eq!(apply(&mut only2, 2, 1).error, None);
+        assert_eq!(
+            df.bits(),
+            only2.bits(),
+            "{isa:?}: only particle 2 was written"
+        );
+    }
+}

@@ -37,8 +37,20 @@ fn main() {
     let s = 38usize;
     let n = s * s * s;
     let h = 0.02f32;
+    // A lattice at spacing h/2, shuffled and then sorted by cell (x fastest), as a host and
+    // the C++ benchmark order their particles.
+    let mut order: Vec<usize> = (0..n).collect();
+    let mut g = 0x9e37_79b9_7f4a_7c15u64;
+    for i in (1..n).rev() {
+        g ^= g << 13;
+        g ^= g >> 7;
+        g ^= g << 17;
+        order.swap(i, (g % (i as u64 + 1)) as usize);
+    }
+    let key = |i: usize| (i % s / 2) + s * ((i / s % s / 2) + s * (i / (s * s) / 2));
+    order.sort_by_key(|&i| key(i));
     let mut x = Vec::new();
-    for i in 0..n {
+    for &i in &order {
         let mut q = i;
         for _ in 0..D {
             x.push((4.0 + ((q % s) as f32 + 0.5) * 0.5) * h);

@@ -90,6 +90,20 @@ pub trait Lane:
     /// # Safety
     /// `p[0..n]` is valid for writing.
     unsafe fn store_n(self, p: *mut Self::Scalar, n: usize);
+    /// Lane `i` from `p[i]` for every `i` with bit `i` of `bits` set, the others 0 (bits
+    /// `LANES..` clear).
+    ///
+    /// # Safety
+    /// Every such `p.wrapping_add(i)` is valid for reading (`p` itself need not be: the other
+    /// lanes are not accessed and do not fault).
+    #[must_use]
+    unsafe fn load_mask(p: *const Self::Scalar, bits: u32) -> Self;
+    /// Writes lane `i` to `p[i]` for every `i` with bit `i` of `bits` set (bits `LANES..`
+    /// clear).
+    ///
+    /// # Safety
+    /// Every such `p.wrapping_add(i)` is valid for writing.
+    unsafe fn store_mask(self, p: *mut Self::Scalar, bits: u32);
     /// `self·a + b`: fused (one rounding) on the SIMD paths, which all have an FMA
     /// instruction; two roundings on scalars (a software FMA costs ~6 ns without one).
     #[must_use]
@@ -219,6 +233,20 @@ impl<T: Real> Lane for T {
     #[inline(always)]
     unsafe fn store_n(self, p: *mut T, n: usize) {
         if n > 0 {
+            p.write_unaligned(self);
+        }
+    }
+    #[inline(always)]
+    unsafe fn load_mask(p: *const T, bits: u32) -> T {
+        if bits & 1 == 1 {
+            p.read_unaligned()
+        } else {
+            T::ZERO
+        }
+    }
+    #[inline(always)]
+    unsafe fn store_mask(self, p: *mut T, bits: u32) {
+        if bits & 1 == 1 {
             p.write_unaligned(self);
         }
     }
@@ -502,6 +530,20 @@ impl<V: Lane> Lane for X2<V> {
         }
     }
     #[inline(always)]
+    unsafe fn load_mask(p: *const Self::Scalar, bits: u32) -> Self {
+        let lo = bits & ((1u32 << V::LANES) - 1);
+        X2([
+            V::load_mask(p, lo),
+            V::load_mask(p.wrapping_add(V::LANES), bits >> V::LANES),
+        ])
+    }
+    #[inline(always)]
+    unsafe fn store_mask(self, p: *mut Self::Scalar, bits: u32) {
+        let lo = bits & ((1u32 << V::LANES) - 1);
+        self.0[0].store_mask(p, lo);
+        self.0[1].store_mask(p.wrapping_add(V::LANES), bits >> V::LANES);
+    }
+    #[inline(always)]
     fn mul_add(self, a: Self, b: Self) -> Self {
         X2([
             self.0[0].mul_add(a.0[0], b.0[0]),
@@ -591,6 +633,39 @@ mod tests {
                     V::Scalar::from_i32(-7)
                 };
                 assert_eq!(x.to_f64(), want.to_f64(), "store_n {n} lane {i}");
+            }
+        }
+        // Arbitrary lane sets, from a pointer one before the buffer (lane 0 never set then).
+        for bits in 0..1u32 << V::LANES {
+            for shift in 0..2usize {
+                let bits = bits & !(shift as u32);
+                let base = src.as_ptr().wrapping_add(1).wrapping_sub(shift);
+                // SAFETY: lane `i` is read only with bit `i` set, at `src[i + 1 - shift]`,
+                // inside `src` (`LANES ≤ 16 < 32`).
+                let v = unsafe { V::load_mask(base, bits) };
+                let mut all = [V::Scalar::from_i32(-7); 32];
+                v.store(&mut all);
+                for (i, x) in all[..V::LANES].iter().enumerate() {
+                    let want = if bits >> i & 1 == 1 {
+                        src[i + 1 - shift]
+                    } else {
+                        V::Scalar::ZERO
+                    };
+                    assert_eq!(x.to_f64(), want.to_f64(), "load_mask {bits:#x} lane {i}");
+                }
+                let mut dst = [V::Scalar::from_i32(-7); 32];
+                let b = dst.as_mut_ptr().wrapping_add(1).wrapping_sub(shift);
+                // SAFETY: as above, in `dst`.
+                unsafe { V::load(&src).store_mask(b, bits) };
+                for (i, x) in dst.iter().enumerate() {
+                    let lane = (i + shift).wrapping_sub(1);
+                    let want = if lane < V::LANES && bits >> lane & 1 == 1 {
+                        src[lane]
+                    } else {
+                        V::Scalar::from_i32(-7)
+                    };
+                    assert_eq!(x.to_f64(), want.to_f64(), "store_mask {bits:#x} at {i}");
+                }
             }
         }
     }

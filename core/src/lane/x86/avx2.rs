@@ -38,6 +38,20 @@ unsafe fn mask8(n: usize) -> __m256i {
     )
 }
 
+/// The AVX2 mask of the lanes `i` of eight 32-bit lanes with bit `i` of `bits` set.
+#[inline(always)]
+unsafe fn mask8_bits(bits: u32) -> __m256i {
+    let b = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+    _mm256_cmpeq_epi32(_mm256_and_si256(_mm256_set1_epi32(bits as i32), b), b)
+}
+
+/// The AVX2 mask of the lanes `i` of four 64-bit lanes with bit `i` of `bits` set.
+#[inline(always)]
+unsafe fn mask4_bits(bits: u32) -> __m256i {
+    let b = _mm256_setr_epi64x(1, 2, 4, 8);
+    _mm256_cmpeq_epi64(_mm256_and_si256(_mm256_set1_epi64x(bits as i64), b), b)
+}
+
 /// The AVX2 mask of lanes `0..n` of four 64-bit lanes (sign bits set).
 #[inline(always)]
 unsafe fn mask4(n: usize) -> __m256i {
@@ -82,6 +96,14 @@ impl Lane for F32x8 {
     #[inline(always)]
     unsafe fn store_n(self, p: *mut f32, n: usize) {
         _mm256_maskstore_ps(p, mask8(n), self.0)
+    }
+    #[inline(always)]
+    unsafe fn load_mask(p: *const f32, bits: u32) -> Self {
+        F32x8(_mm256_maskload_ps(p, mask8_bits(bits)))
+    }
+    #[inline(always)]
+    unsafe fn store_mask(self, p: *mut f32, bits: u32) {
+        _mm256_maskstore_ps(p, mask8_bits(bits), self.0)
     }
     #[inline(always)]
     unsafe fn scatter(self, base: *mut f32, stride: usize, keep: u32) {
@@ -253,6 +275,14 @@ impl Lane for F64x4 {
     #[inline(always)]
     unsafe fn store_n(self, p: *mut f64, n: usize) {
         _mm256_maskstore_pd(p, mask4(n), self.0)
+    }
+    #[inline(always)]
+    unsafe fn load_mask(p: *const f64, bits: u32) -> Self {
+        F64x4(_mm256_maskload_pd(p, mask4_bits(bits)))
+    }
+    #[inline(always)]
+    unsafe fn store_mask(self, p: *mut f64, bits: u32) {
+        _mm256_maskstore_pd(p, mask4_bits(bits), self.0)
     }
     #[inline(always)]
     unsafe fn scatter(self, base: *mut f64, stride: usize, keep: u32) {

@@ -107,6 +107,14 @@ macro_rules! avx512_lane {
                 $mask_storeu(p.cast(), ((1u32 << n) - 1) as $kraw, self.0)
             }
             #[inline(always)]
+            unsafe fn load_mask(p: *const $t, bits: u32) -> Self {
+                $v($maskz_loadu(bits as $kraw, p.cast()))
+            }
+            #[inline(always)]
+            unsafe fn store_mask(self, p: *mut $t, bits: u32) {
+                $mask_storeu(p.cast(), bits as $kraw, self.0)
+            }
+            #[inline(always)]
             unsafe fn scatter(self, base: *mut $t, stride: usize, keep: u32) {
                 $scatter::<{ core::mem::size_of::<$t>() as i32 }>(
                     base.cast(),

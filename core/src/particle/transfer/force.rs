@@ -9,6 +9,7 @@
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
 use super::nodes::{add, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes};
+use super::tile::{axis0, factors, grad_coef, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
@@ -285,57 +286,131 @@ impl<T: BatchReal, const D: usize> ApplyOp<'_, T, D>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`): each particle's
+    /// `δf` goes into a node tile ([`super::tile`]) that is added to `df` per run of nearby
+    /// particles; a run whose sum would not be finite is added again one particle at a time
+    /// ([`one`]), which refuses the particles that overflow.
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
-        let sl = slot_len(D);
+        debug_assert_eq!(R::LANES, TILE_X);
         let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
-        let (kernel, h, view) = (self.kernel, self.h, self.view);
+        let mut tile = Tile::<R, D>::new();
+        let mut run = [0usize; MAX_RUN];
+        let mut nrun = 0;
+        let outs = &self.view.df;
         for i in 0..self.n {
-            // SAFETY: `apply`'s contract: `slots` holds `n` slots, `x` `n` positions.
-            let r = unsafe {
-                let slot = core::slice::from_raw_parts(self.slots.add(i * sl), sl);
-                if slot[0] != tag::<T>(D) {
-                    Err(Error::NotPrepared)
-                } else {
-                    let xp = rd_vec::<T, D>(self.x, i);
-                    one::<T, R, D, K, N>(kernel, h, &xp, slot, view, &cst)
+            // SAFETY: `apply`'s contract. (A `match`, not a closure: a closure is not always
+            // inlined into the caller's target features.)
+            let (s, rel, m) = match unsafe { self.gather::<R, K, N>(i, &cst) } {
+                Ok(g) => g,
+                Err(e) => {
+                    first.note(i, Err(e));
+                    continue;
                 }
             };
+            let fits = if nrun < MAX_RUN {
+                tile.place::<K>(&rel, &s.fx)
+            } else {
+                None
+            };
+            let sp = match fits {
+                Some(sp) => sp,
+                None => {
+                    // SAFETY: as above.
+                    unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &cst, &mut first) };
+                    nrun = 0;
+                    // An empty tile takes any stencil.
+                    tile.place::<K>(&rel, &s.fx).unwrap_or([0; D])
+                }
+            };
+            let (w, dw) = axis0::<T, R, D, K>(&s, sp[0]);
+            let mut coef = [Coef {
+                p: R::splat(T::ZERO),
+                e: None,
+                b: None,
+            }; MAX_CH];
+            for (a, c) in coef.iter_mut().enumerate().take(D) {
+                *c = grad_coef(w, dw, &m, a, T::ONE);
+            }
+            tile.add::<K, N>(&sp, &factors::<T, D, K, N>(&s), &coef, outs.len());
+            run[nrun] = i;
+            nrun += 1;
+        }
+        // SAFETY: as above.
+        unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &cst, &mut first) };
+        first.status()
+    }
+
+    /// Particle `i`'s stencil, box-relative base and `M = 𝒜(G)`.
+    ///
+    /// # Safety
+    /// `apply`'s contract.
+    #[inline(always)]
+    unsafe fn gather<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        i: usize,
+        cst: &[[T; 8]; N],
+    ) -> Result<(Stencil<T, D>, [isize; D], Mat<T, D>)> {
+        let sl = slot_len(D);
+        let slot = core::slice::from_raw_parts(self.slots.add(i * sl), sl);
+        if slot[0] != tag::<T>(D) {
+            return Err(Error::NotPrepared);
+        }
+        let xp = rd_vec::<T, D>(self.x, i);
+        let s = Stencil::new(self.kernel, Grid::Collocated, self.h, &xp)?;
+        let rel = rel_base(&s, &self.view.nodes)?;
+        let g = grad_u::<T, R, D, K, N>(&s, &rel, self.view, cst)?;
+        Ok((s, rel, apply_slot(slot, &g)))
+    }
+
+    /// Adds the tile to `df`; if that would write a non-finite value, adds the run's particles
+    /// one by one instead.
+    ///
+    /// # Safety
+    /// `apply`'s contract.
+    #[inline(always)]
+    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        tile: &mut Tile<R, D>,
+        run: &[usize],
+        cst: &[[T; 8]; N],
+        first: &mut FirstFailure,
+    ) {
+        if tile.add_to_grid::<K>(&self.view.df) {
+            return;
+        }
+        for &i in run {
+            let r = self
+                .gather::<R, K, N>(i, cst)
+                .and_then(|(s, rel, m)| one::<T, D, K, N>(&s, &rel, &m, self.view));
             first.note(i, r);
         }
-        first.status()
     }
 }
 
-/// One particle of [`apply`]: `G = Σ_j δu_j ∇w_jᵀ` over the nodes in order, `M = 𝒜(G)`, then
-/// `δf_i = M ∇w_i` added per channel, with every old value kept and put back on overflow.
+/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`) in order.
+///
+/// # Safety
+/// `apply`'s contract; the stencil is inside the box.
 #[inline(always)]
-unsafe fn one<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
-    kernel: Kernel,
-    h: T,
-    x: &[T; D],
-    slot: &[T],
+unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
     view: &ForceView<T, D>,
     cst: &[[T; 8]; N],
-) -> Result<()>
-where
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-{
-    let s = Stencil::new(kernel, Grid::Collocated, h, x)?;
-    let rel = rel_base(&s, &view.nodes)?;
+) -> Result<Mat<T, D>> {
     let mut u = [[T::ZERO; N]; D];
     let mut chk = true;
     for a in 0..D {
         let c = &view.du[a];
-        chk &= read::<T, R, D, K, N>(c.data, &table(c, &rel), c.stride[0], &mut u[a]);
+        chk &= read::<T, R, D, K, N>(c.data, &table(c, rel), c.stride[0], &mut u[a]);
     }
     if !chk {
         return Err(Error::NonFinite);
     }
     // G row by row: lanes 1 + d + b of Σ_j δu_{a,j} m_j are Σ_j δu_{a,j} ∂w_j/∂x_b.
-    let m = rows::<T, R, D, K, N>(&s, cst);
+    let m = rows::<T, R, D, K, N>(s, cst);
     let mut sum = [R::splat(T::ZERO); D];
     for j in 0..N {
         for a in 0..D {
@@ -350,11 +425,31 @@ where
             g.cols[b][a] = l[1 + D + b];
         }
     }
-    let nd = nodes::<T, D, K, N>(&s);
-    let m = apply_slot(slot, &g);
+    Ok(g)
+}
+
+/// One particle of [`apply`] added on its own: `δf_i = M ∇w_i` added per channel, with every
+/// old value kept and put back on overflow.
+///
+/// # Safety
+/// `apply`'s contract; the stencil is inside the box.
+#[inline(always)]
+unsafe fn one<T: Real, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
+    m: &Mat<T, D>,
+    view: &ForceView<T, D>,
+) -> Result<()>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let nd = nodes::<T, D, K, N>(s);
     let mut f = [[T::ZERO; N]; D];
     for i in 0..N {
-        let gi: [T; D] = core::array::from_fn(|b| nd.g[b][i]);
+        let mut gi = [T::ZERO; D];
+        for (b, g) in gi.iter_mut().enumerate() {
+            *g = nd.g[b][i];
+        }
         let fi = m.mul_vec(gi);
         for a in 0..D {
             f[a][i] = fi[a];
@@ -362,10 +457,11 @@ where
     }
     let mut old = [[MaybeUninit::<T>::uninit(); N]; D];
     let mut tabs = [[[0isize; 4]; D]; D];
+    let mut chk = true;
     for a in 0..D {
         let c = &view.df[a];
-        tabs[a] = table(c, &rel);
-        chk &= add::<T, R, D, K, N>(c.data, &tabs[a], c.stride[0], &f[a], &mut old[a]);
+        tabs[a] = table(c, rel);
+        chk &= add::<T, ScalarRow<T>, D, K, N>(c.data, &tabs[a], c.stride[0], &f[a], &mut old[a]);
     }
     if !chk {
         for a in (0..D).rev() {

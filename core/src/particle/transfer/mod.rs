@@ -31,6 +31,7 @@ pub mod force;
 pub mod g2p;
 mod nodes;
 pub mod p2g;
+mod tile;
 
 pub use crate::kernel::batch::BatchStatus;
 
@@ -346,11 +347,12 @@ impl FirstFailure {
             err: None,
         }
     }
-    /// Records the result of particle `i` (kept only if it is the first failure).
+    /// Records the result of particle `i` (kept only if it is the failure of lowest index so
+    /// far: P2G adds some particles after later ones have failed).
     #[inline(always)]
     pub fn note(&mut self, i: usize, r: Result<()>) {
         if let Err(e) = r {
-            if self.err.is_none() {
+            if self.err.is_none() || i < self.at {
                 self.at = i;
                 self.err = Some(e);
             }

@@ -70,7 +70,7 @@ pub(crate) struct Nodes<T, const D: usize, const N: usize> {
 /// The factors of stencil row `r` (the nodes `r·K .. r·K + K`): `c[0]` the product of the
 /// weights of axes `1..d` in axis order, `c[a]` (`a ≥ 1`) the same with `dw_a` for `w_a`.
 #[inline(always)]
-fn row_factors<T: Real, const D: usize, const K: usize, const N: usize>(
+pub(crate) fn row_factors<T: Real, const D: usize, const K: usize, const N: usize>(
     s: &Stencil<T, D>,
     r: usize,
 ) -> [T; D] {

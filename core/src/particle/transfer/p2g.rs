@@ -12,6 +12,7 @@
 //! node loop is per particle.
 
 use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
+use super::tile::{axis0, factors, grad_coef, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
@@ -25,7 +26,6 @@ use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::check_particle;
 use crate::particle::{Dilation, Material, Particle};
 use core::mem::MaybeUninit;
-use core::ptr;
 
 /// Where P2G writes: a node box and the channels to scatter-add into (absent channels are
 /// skipped). On a MAC face grid `a` only `mass`, `momentum[a]` and `force[a]` are written.
@@ -60,7 +60,13 @@ pub struct P2gArgs<T> {
     pub impulse_dt: T,
 }
 
-const CH: usize = 10; // mass, momentum ×3, force ×3, heat capacity, thermal energy, conductivity
+/// The particles of the current tile run (index and deviatoric stress), for the one-by-one
+/// path: it forms their [`Ready`] again (a copy of each would cost more than the rare redo).
+struct Run<T, const D: usize> {
+    n: usize,
+    idx: [usize; MAX_RUN],
+    tau: [Mat<T, D>; MAX_RUN],
+}
 
 /// A particle ready for its node loop.
 #[derive(Clone, Copy)]
@@ -126,7 +132,11 @@ where
         ps,
         view,
         first: FirstFailure::new(n),
+        outs: [OutChannel::none(); MAX_CH],
+        kinds: [0; MAX_CH],
+        na: 0,
     };
+    op.active();
     dispatch::<T, _>(isa, &mut op);
     op.first.status()
 }
@@ -139,6 +149,11 @@ struct P2gOp<'a, T, const D: usize> {
     ps: &'a Particles<T>,
     view: &'a P2gView<T, D>,
     first: FirstFailure,
+    /// The output channels written, in the order they are added, and their kinds (0 mass,
+    /// `1 + a` momentum, `4 + a` force, 7 heat capacity, 8 thermal energy, 9 conductivity).
+    outs: [OutChannel<T, D>; MAX_CH],
+    kinds: [usize; MAX_CH],
+    na: usize,
 }
 
 /// What the scalar pass knows about a particle before its stress.
@@ -234,36 +249,9 @@ where
         r: &Ready<T, D>,
         oc: &[[T; N]; D],
     ) -> Result<()> {
-        let v = self.view;
-        let rel = rel_base(&r.s, &v.nodes)?;
-        let comps: (usize, usize) = match self.args.grid {
-            Grid::Collocated => (0, D),
-            Grid::Face(a) => (a, a + 1),
-        };
-        let heat_on = self.material.heat.is_some() && self.args.grid == Grid::Collocated;
-        // The active channels: (kind, data, offset table, axis-0 stride).
-        let mut act: [(usize, *mut T, [[isize; 4]; D], isize); CH] =
-            [(0, ptr::null_mut(), [[0; 4]; D], 0); CH];
-        let mut na = 0;
-        {
-            let mut add = |kind: usize, ch: &OutChannel<T, D>| {
-                if !ch.data.is_null() {
-                    act[na] = (kind, ch.data, table(ch, &rel), ch.stride[0]);
-                    na += 1;
-                }
-            };
-            add(0, &v.mass);
-            for a in comps.0..comps.1 {
-                add(1 + a, &v.momentum[a]);
-                add(4 + a, &v.force[a]);
-            }
-            if heat_on {
-                add(7, &v.heat_capacity);
-                add(8, &v.thermal_energy);
-                add(9, &v.conductivity);
-            }
-        }
-        let act = &act[..na];
+        let rel = rel_base(&r.s, &self.view.nodes)?;
+        let comps = self.comps();
+        let act = self.outs[..self.na].iter().zip(&self.kinds[..self.na]);
         let nd = nodes::<T, D, K, N>(&r.s);
         let idt = self.args.impulse_dt;
         // The force on the nodes along axis `a`.
@@ -279,11 +267,12 @@ where
                 }
             }
         }
-        let mut old = [[MaybeUninit::<T>::uninit(); N]; CH];
+        let mut old = [[MaybeUninit::<T>::uninit(); N]; MAX_CH];
         let mut ok = true;
-        for (j, (kind, data, t, s0)) in act.iter().enumerate() {
+        for (j, (ch, &kind)) in act.enumerate() {
+            let t = table(ch, &rel);
             let mut val = [T::ZERO; N];
-            match *kind {
+            match kind {
                 0 => {
                     for i in 0..N {
                         val[i] = nd.w[i] * r.mass;
@@ -301,34 +290,182 @@ where
                     }
                 }
                 4..=6 => val = force[kind - 4],
-                _ => {
+                k => {
                     for i in 0..N {
-                        val[i] = nd.w[i] * r.heat[kind - 7];
+                        val[i] = nd.w[i] * r.heat[k - 7];
                     }
                 }
             }
-            ok &= add::<T, R, D, K, N>(*data, t, *s0, &val, &mut old[j]);
+            ok &= add::<T, R, D, K, N>(ch.data, &t, ch.stride[0], &val, &mut old[j]);
         }
         if ok {
             return Ok(());
         }
-        for (j, (_, data, t, s0)) in act.iter().enumerate().rev() {
-            restore::<T, D, K, N>(*data, t, *s0, &old[j]);
+        for (j, ch) in self.outs[..self.na].iter().enumerate().rev() {
+            let t = table(ch, &rel);
+            restore::<T, D, K, N>(ch.data, &t, ch.stride[0], &old[j]);
         }
         Err(Error::Overflow)
     }
 
+    /// The velocity components a call writes: all on the collocated grid, `a` on face grid `a`.
     #[inline(always)]
+    fn comps(&self) -> (usize, usize) {
+        match self.args.grid {
+            Grid::Collocated => (0, D),
+            Grid::Face(a) => (a, a + 1),
+        }
+    }
+
+    /// The output channels a call writes, in the order they are added.
+    fn active(&mut self) {
+        let v = self.view;
+        let comps = self.comps();
+        let heat_on = self.material.heat.is_some() && self.args.grid == Grid::Collocated;
+        let mut add = |kind: usize, ch: &OutChannel<T, D>| {
+            if !ch.data.is_null() {
+                self.outs[self.na] = *ch;
+                self.kinds[self.na] = kind;
+                self.na += 1;
+            }
+        };
+        add(0, &v.mass);
+        for a in comps.0..comps.1 {
+            add(1 + a, &v.momentum[a]);
+            add(4 + a, &v.force[a]);
+        }
+        if heat_on {
+            add(7, &v.heat_capacity);
+            add(8, &v.thermal_energy);
+            add(9, &v.conductivity);
+        }
+    }
+
+    /// The tile lane vectors of a particle's node values per active channel (see
+    /// [`super::tile`]), for lane offset `s0` along axis 0.
+    #[inline(always)]
+    fn coef<R: Lane<Scalar = T>, const K: usize>(
+        &self,
+        r: &Ready<T, D>,
+        s0: usize,
+    ) -> [Coef<R, D>; MAX_CH] {
+        let sp = R::splat;
+        let (w, dw) = axis0::<T, R, D, K>(&r.s, s0);
+        // The axis-0 node offsets o₀ of the lanes (exact small integers).
+        let mut lane = [T::ZERO; TILE_X];
+        for (l, x) in lane.iter_mut().enumerate() {
+            *x = T::from_i32(l as i32 - s0 as i32);
+        }
+        let o0 = R::load(&lane);
+        let idt = self.args.impulse_dt;
+        let only = |p: R| Coef {
+            p,
+            e: None,
+            b: None,
+        };
+        let mut out = [only(sp(T::ZERO)); MAX_CH];
+        for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
+            *c = match kind {
+                0 => only(w * sp(r.mass)),
+                k @ 1..=3 => {
+                    // w (q₀ + (mCh) o) + Δt_f f.
+                    let a = k - 1;
+                    let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
+                    let mut e = [sp(T::ZERO); D];
+                    for (b, x) in e.iter_mut().enumerate().skip(1) {
+                        *x = w * sp(r.mch.cols[b][a]);
+                    }
+                    if idt == T::ZERO {
+                        Coef {
+                            p: w * q,
+                            e: Some(e),
+                            b: None,
+                        }
+                    } else {
+                        let f = grad_coef(w, dw, &r.fm, a, idt);
+                        Coef {
+                            p: w.mul_add(q, f.p),
+                            e: Some(e),
+                            b: f.b,
+                        }
+                    }
+                }
+                k @ 4..=6 => grad_coef(w, dw, &r.fm, k - 4, T::ONE),
+                k => only(w * sp(r.heat[k - 7])),
+            };
+        }
+        out
+    }
+
+    /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
+    /// particle does not fit in its tile or the run is full.
+    #[inline(always)]
+    unsafe fn to_tile<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        i: usize,
+        r: &Ready<T, D>,
+        tau_dev: Mat<T, D>,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
+        oc: &[[T; N]; D],
+    ) -> Result<()> {
+        let rel = rel_base(&r.s, &self.view.nodes)?;
+        if run.n == MAX_RUN {
+            self.flush::<R, K, N>(tile, run, oc);
+        }
+        let s = loop {
+            if let Some(s) = tile.place::<K>(&rel, &r.s.fx) {
+                break s;
+            }
+            // An empty tile takes any stencil.
+            self.flush::<R, K, N>(tile, run, oc);
+        };
+        let coef = self.coef::<R, K>(r, s[0]);
+        tile.add::<K, N>(&s, &factors::<T, D, K, N>(&r.s), &coef, self.na);
+        run.idx[run.n] = i;
+        run.tau[run.n] = tau_dev;
+        run.n += 1;
+        Ok(())
+    }
+
+    /// Adds the tile to the grid and empties it; if a new node value is not finite, the grid
+    /// is left as it was and the run's particles are added one by one ([`Self::scatter`]),
+    /// which refuses the ones that overflow.
+    #[inline(always)]
+    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
+        oc: &[[T; N]; D],
+    ) {
+        let outs = &self.outs[..self.na];
+        if !tile.add_to_grid::<K>(outs) {
+            for m in 0..run.n {
+                // `pre` and `ready` succeeded for this particle before, with these inputs.
+                let r = self
+                    .pre(run.idx[m])
+                    .and_then(|pre| self.ready(&pre, run.tau[m]))
+                    .and_then(|r| self.scatter::<R, K, N>(&r, oc));
+                self.first.note(run.idx[m], r);
+            }
+        }
+        run.n = 0;
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
         pre: &Pre<T, D>,
         tau_dev: Mat<T, D>,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
         oc: &[[T; N]; D],
     ) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => self.scatter::<R, K, N>(&r, oc),
+            Ok(r) => self.to_tile::<R, K, N>(i, &r, tau_dev, tile, run, oc),
         };
         self.first.note(i, r);
     }
@@ -361,7 +498,14 @@ where
     fn run_nodes<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
     ) -> BatchStatus {
+        debug_assert_eq!(R::LANES, TILE_X);
         let oc = node_offsets::<T, D, K, N>();
+        let mut tile = Tile::<R, D>::new();
+        let mut run = Run {
+            n: 0,
+            idx: [0; MAX_RUN],
+            tau: [Mat::ZERO; MAX_RUN],
+        };
         let lanes = V::LANES;
         let mut start = 0;
         while start < self.n {
@@ -429,11 +573,15 @@ where
                         }
                     }
                     // SAFETY: `p2g`'s contract: valid channels over the box.
-                    unsafe { self.finish::<R, K, N>(start + l, &pr, tau, &oc) };
+                    unsafe {
+                        self.finish::<R, K, N>(start + l, &pr, tau, &mut tile, &mut run, &oc)
+                    };
                 }
             }
             start += len;
         }
+        // SAFETY: as above.
+        unsafe { self.flush::<R, K, N>(&mut tile, &mut run, &oc) };
         self.first.status()
     }
 }

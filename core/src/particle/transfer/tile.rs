@@ -1,0 +1,305 @@
+//! P2G's node tile: the contributions of a run of particles that lie close together are summed
+//! in a small local block of nodes first, and the block is added to the host's grid once.
+//!
+//! A host sorts its particles by cell, so consecutive particles reach mostly the same nodes.
+//! Adding each particle to the grid on its own would load every node row right after the
+//! previous particle stored it, through masked vector moves that the store buffer cannot
+//! forward (the load waits for the store to reach the cache). The tile is written with whole
+//! eight-lane rows, which forward, and the grid is touched once per run.
+//!
+//! **Geometry.** A tile has an origin node `org` (box-relative) and spans 8 nodes along axis 0
+//! (one eight-lane row `R`) and `K + 1` nodes along each other axis (`K` nodes per axis of the
+//! kernel). A particle with stencil base `b` joins if `0 ≤ b₀ − org₀ ≤ 8 − K` and
+//! `0 ≤ b_a − org_a ≤ 1` (`a ≥ 1`); the first particle of a run sets `org = b − [fx < 1]`
+//! per axis, which puts every particle of its grid cell in the tile (a quadratic stencil's base
+//! is its cell or the cell before, by `fx`) and up to four more cells along axis 0.
+//!
+//! **Rows.** Tile row `t = Σ_{a≥1} t_a (K+1)^{a−1}` holds the nodes `org + (l, t₁, …)`,
+//! `l = 0..8`, in lanes `l`. A particle's stencil row (axis-0 nodes `b₀ + o₀`, other offsets
+//! `o_a`) adds into tile row `t_a = b_a − org_a + o_a` at lanes `s₀ + o₀`, `s₀ = b₀ − org₀`.
+//!
+//! **Node values** in a stencil row, with `c` the row factors of [`super::nodes`] (`c₀` the
+//! product of the other axes' weights, `c_a` the same with `∂w_a` for `w_a`) and `W`, `W'` the
+//! axis-0 weights and derivatives in their tile lanes: every channel's value is
+//! `c₀ P + Σ_{a≥1} c₀ o_a E_a + Σ_{a≥1} c_a B_a` with per-particle lane vectors `P`, `E_a`,
+//! `B_a` ([`Coef`]); e.g. momentum `w (q₀ + m C h o) + Δt_f f` gives
+//! `P = W (q₀ + (mCh)_{·0} o₀) + Δt_f W' fm_{0·}`, `E_a = W (mCh)_{·a}`, `B_a = Δt_f W fm_{a·}`.
+//! The sums are the same as the per-node ones up to the order of the additions.
+//!
+//! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
+//! the old values are put back and the run's particles are added one by one by the
+//! per-particle path, which finds the particles that fail. A run's tile sum can be finite where
+//! adding its particles one by one would pass through a non-finite value (the sum of two
+//! huge opposite contributions): the run is then accepted, with the finite, more accurate sum.
+
+use super::nodes::{row_factors, Offsets};
+use super::OutChannel;
+use crate::lane::Lane;
+use crate::mat::Mat;
+use crate::particle::stencil::Stencil;
+use crate::scalar::Real;
+use core::mem::MaybeUninit;
+
+/// Lanes of a tile row (nodes along axis 0): the eight lanes of the row types of
+/// [`crate::kernel::batch::LaneOp::run_rows`].
+pub(super) const TILE_X: usize = 8;
+/// Most tile rows: `(K + 1)^{d−1}` up to the cubic kernel in 3D.
+pub(super) const MAX_ROWS: usize = 25;
+/// Most particles in a run (kept for the one-by-one path).
+pub(super) const MAX_RUN: usize = 16;
+/// Most channels written by one P2G call.
+pub(super) const MAX_CH: usize = 10;
+
+/// The per-particle lane vectors of one channel's node values (see the module docs). A term
+/// that the channel does not have is skipped (`e`, `b` false).
+#[derive(Clone, Copy)]
+pub(super) struct Coef<R, const D: usize> {
+    pub p: R,
+    pub e: Option<[R; D]>,
+    pub b: Option<[R; D]>,
+}
+
+/// A tile of summed node values per channel.
+pub(super) struct Tile<R, const D: usize> {
+    /// Origin node, box-relative.
+    pub org: [isize; D],
+    /// Lanes written per row (bit `l` for lane `l`); no row written: the tile is empty.
+    pub bits: [u32; MAX_ROWS],
+    /// Whether any row is written.
+    pub used: bool,
+    /// Summed node values per channel and row.
+    pub acc: [[R; MAX_ROWS]; MAX_CH],
+}
+
+impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
+    /// An empty tile.
+    #[inline(always)]
+    pub fn new() -> Self {
+        Self {
+            org: [0; D],
+            bits: [0; MAX_ROWS],
+            used: false,
+            acc: [[R::splat(T::ZERO); MAX_ROWS]; MAX_CH],
+        }
+    }
+
+    /// The lane offsets `s` of a stencil with box-relative base `rel` in this tile, if it fits
+    /// (`K` nodes per axis); on an empty tile, the origin is set first.
+    #[inline(always)]
+    pub fn place<const K: usize>(&mut self, rel: &[isize; D], fx: &[T; D]) -> Option<[usize; D]> {
+        if !self.used {
+            for a in 0..D {
+                self.org[a] = rel[a] - (fx[a] < T::ONE) as isize;
+            }
+        }
+        let mut s = [0usize; D];
+        for a in 0..D {
+            let d = rel[a] - self.org[a];
+            let lim = if a == 0 { (TILE_X - K) as isize } else { 1 };
+            if d < 0 || d > lim {
+                return None;
+            }
+            s[a] = d as usize;
+        }
+        Some(s)
+    }
+
+    /// Adds the node values of one particle: stencil rows `r` (`N/K` of them, axis-0 nodes
+    /// `r·K..r·K + K`) with row factors `c[r]`, for the first `nc` channels of `coef`.
+    #[inline(always)]
+    pub fn add<const K: usize, const N: usize>(
+        &mut self,
+        s: &[usize; D],
+        c: &[[T; D]; N],
+        coef: &[Coef<R, D>; MAX_CH],
+        nc: usize,
+    ) {
+        let lanes = ((1u32 << K) - 1) << s[0];
+        for (r, cr) in c.iter().enumerate().take(N / K) {
+            // Tile row and the row's offsets along axes 1.. (node r·K has o₀ = 0).
+            let o = Offsets::<D, K, N>::O[r * K];
+            let mut t = 0usize;
+            let mut step = 1usize;
+            let mut c0o = [T::ZERO; D];
+            for a in 1..D {
+                t += (s[a] + o[a]) * step;
+                step *= K + 1;
+                c0o[a] = cr[0] * T::from_i32(o[a] as i32);
+            }
+            self.bits[t] |= lanes;
+            let c0 = R::splat(cr[0]);
+            let (mut ca, mut co) = ([c0; D], [c0; D]);
+            for a in 1..D {
+                ca[a] = R::splat(cr[a]);
+                co[a] = R::splat(c0o[a]);
+            }
+            for (j, k) in coef.iter().enumerate().take(nc) {
+                let mut v = c0.mul_add(k.p, self.acc[j][t]);
+                if let Some(e) = &k.e {
+                    for a in 1..D {
+                        v = co[a].mul_add(e[a], v);
+                    }
+                }
+                if let Some(b) = &k.b {
+                    for a in 1..D {
+                        v = ca[a].mul_add(b[a], v);
+                    }
+                }
+                self.acc[j][t] = v;
+            }
+        }
+        self.used = true;
+    }
+}
+
+impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
+    /// Adds the tile to the channels `outs` (channel `j` gets `acc[j]`, in order) and empties
+    /// it. Returns whether every new node value is finite; if one is not, every old value is
+    /// put back (last written first, so that aliased channels are restored too).
+    ///
+    /// # Safety
+    /// Every node of the written lanes is valid for reading and writing in every channel (the
+    /// tile's particles passed [`super::nodes::rel_base`]).
+    #[inline(always)]
+    pub unsafe fn add_to_grid<const K: usize>(&mut self, outs: &[OutChannel<T, D>]) -> bool {
+        if !self.used {
+            return true;
+        }
+        let rows = (K + 1).pow(D as u32 - 1);
+        let mut old = [[MaybeUninit::<R>::uninit(); MAX_ROWS]; MAX_CH];
+        let mut ok = true;
+        for (j, ch) in outs.iter().enumerate() {
+            for t in 0..rows {
+                let bits = self.bits[t];
+                if bits == 0 {
+                    continue;
+                }
+                let p = ch.data.wrapping_offset(self.row_offset::<K>(&ch.stride, t));
+                let x = load_row::<T, R>(p, ch.stride[0], bits);
+                let nv = x + self.acc[j][t];
+                ok &= R::all(nv.is_finite());
+                old[j][t].write(x);
+                store_row(nv, p, ch.stride[0], bits);
+            }
+        }
+        if !ok {
+            for (j, ch) in outs.iter().enumerate().rev() {
+                for t in (0..rows).rev() {
+                    let bits = self.bits[t];
+                    if bits != 0 {
+                        let p = ch.data.wrapping_offset(self.row_offset::<K>(&ch.stride, t));
+                        store_row(old[j][t].assume_init(), p, ch.stride[0], bits);
+                    }
+                }
+            }
+        }
+        for t in 0..rows {
+            if self.bits[t] != 0 {
+                for acc in self.acc.iter_mut().take(outs.len()) {
+                    acc[t] = R::splat(T::ZERO);
+                }
+                self.bits[t] = 0;
+            }
+        }
+        self.used = false;
+        ok
+    }
+
+    /// The offset (in scalars) of tile row `t` from a channel's node `lo`, for its strides.
+    #[inline(always)]
+    fn row_offset<const K: usize>(&self, stride: &[isize; D], t: usize) -> isize {
+        let mut off = self.org[0] * stride[0];
+        let mut q = t;
+        for a in 1..D {
+            off += (self.org[a] + (q % (K + 1)) as isize) * stride[a];
+            q /= K + 1;
+        }
+        off
+    }
+}
+
+/// The lanes `bits` of a node row at `p` with axis-0 stride `s0`, the others 0.
+///
+/// # Safety
+/// The nodes of the lanes in `bits` are valid for reading.
+#[inline(always)]
+unsafe fn load_row<T: Real, R: Lane<Scalar = T>>(p: *const T, s0: isize, bits: u32) -> R {
+    if s0 == 1 {
+        return R::load_mask(p, bits);
+    }
+    let mut l = [T::ZERO; TILE_X];
+    for (i, x) in l.iter_mut().enumerate() {
+        if bits >> i & 1 == 1 {
+            *x = p.wrapping_offset(i as isize * s0).read_unaligned();
+        }
+    }
+    R::load(&l)
+}
+
+/// Writes the lanes `bits` of `v` to a node row at `p` with axis-0 stride `s0`.
+///
+/// # Safety
+/// The nodes of the lanes in `bits` are valid for writing.
+#[inline(always)]
+unsafe fn store_row<T: Real, R: Lane<Scalar = T>>(v: R, p: *mut T, s0: isize, bits: u32) {
+    if s0 == 1 {
+        return v.store_mask(p, bits);
+    }
+    let mut l = [T::ZERO; TILE_X];
+    v.store(&mut l);
+    for (i, x) in l.iter().enumerate() {
+        if bits >> i & 1 == 1 {
+            p.wrapping_offset(i as isize * s0).write_unaligned(*x);
+        }
+    }
+}
+
+/// The axis-0 weights and weight derivatives (1/m) of a stencil in tile lanes `s0..s0 + K`,
+/// zero in the other lanes.
+#[inline(always)]
+pub(super) fn axis0<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
+    s: &Stencil<T, D>,
+    s0: usize,
+) -> (R, R) {
+    let (mut wl, mut dl) = ([T::ZERO; TILE_X], [T::ZERO; TILE_X]);
+    for o in 0..K {
+        wl[s0 + o] = s.w[0][o];
+        dl[s0 + o] = s.dw[0][o];
+    }
+    (R::load(&wl), R::load(&dl))
+}
+
+/// The [`Coef`] of the node values `f Σ_b m_{ab} ∂w/∂x_b` (a force: row `a` of `f m` times
+/// the weight gradient), from the axis-0 lanes `w`, `dw` of [`axis0`]. Written with loops, not
+/// `array::from_fn`: a closure there is not inlined into the caller's target features, and
+/// its vector operations become calls.
+#[inline(always)]
+pub(super) fn grad_coef<T: Real, R: Lane<Scalar = T>, const D: usize>(
+    w: R,
+    dw: R,
+    m: &Mat<T, D>,
+    a: usize,
+    f: T,
+) -> Coef<R, D> {
+    let mut b = [R::splat(T::ZERO); D];
+    for (c, x) in b.iter_mut().enumerate().skip(1) {
+        *x = w * R::splat(f * m.cols[c][a]);
+    }
+    Coef {
+        p: dw * R::splat(f * m.cols[0][a]),
+        e: None,
+        b: Some(b),
+    }
+}
+
+/// The row factors ([`row_factors`]) of every stencil row (`N/K` rows; entries past them 0).
+#[inline(always)]
+pub(super) fn factors<T: Real, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+) -> [[T; D]; N] {
+    let mut c = [[T::ZERO; D]; N];
+    for (q, cq) in c.iter_mut().enumerate().take(N / K) {
+        *cq = row_factors::<T, D, K, N>(s, q);
+    }
+    c
+}
