@@ -18,12 +18,22 @@ use core::ffi::{c_int, c_uint};
 /// for plain momentum; dt for the symplectic-Euler form m v* + dt f, so the host needs no force
 /// channel); `particles`: reads x, v, affine, f_e, f_p, mass, volume0, temperature (THERMAL),
 /// phase (if not NULL; required with PHASE_CHANGE), latent (PHASE_CHANGE); writes nothing.
-/// Stresses use SIMD lanes of the instruction set of ampm_isa(); results do not depend on a
-/// particle's position in the batch.
+/// Stresses use SIMD lanes of the instruction set of ampm_isa(); a particle's stress and node
+/// contributions do not depend on its position in the batch.
+///
+/// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// local block first and the block is added to the grid once, so the rounding of a node value
+/// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
+/// the call fast; any order gives the same sums to rounding.
 ///
 /// Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID if its stencil leaves view->nodes;
-/// AMPM_ERR_OVERFLOW if a node value it would write (old value + contribution) is not finite;
-/// the particle errors of AmpmParticles and the kernels; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW if adding it makes a node value non-finite: when a run's block would write a
+/// non-finite value, the grid is left as it was and the run's particles are added one at a time,
+/// which refuses exactly those; a run whose block sum is finite is accepted even where adding
+/// its particles one at a time would pass through a non-finite value (huge opposite
+/// contributions). The particle errors of AmpmParticles and the kernels; a failed particle
+/// writes nothing.
 /// Whole-call errors (NULL material, particles, view or a particle array the material needs;
 /// bad kernel, grid, h, impulse_dt; dims < 0; n too large): nothing written, *first_failed = 0.
 /// Threads: concurrent calls are safe when the nodes they write do not overlap.
@@ -52,12 +62,22 @@ pub unsafe extern "C" fn ampm_p2g_2d_f32(
 /// for plain momentum; dt for the symplectic-Euler form m v* + dt f, so the host needs no force
 /// channel); `particles`: reads x, v, affine, f_e, f_p, mass, volume0, temperature (THERMAL),
 /// phase (if not NULL; required with PHASE_CHANGE), latent (PHASE_CHANGE); writes nothing.
-/// Stresses use SIMD lanes of the instruction set of ampm_isa(); results do not depend on a
-/// particle's position in the batch.
+/// Stresses use SIMD lanes of the instruction set of ampm_isa(); a particle's stress and node
+/// contributions do not depend on its position in the batch.
+///
+/// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// local block first and the block is added to the grid once, so the rounding of a node value
+/// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
+/// the call fast; any order gives the same sums to rounding.
 ///
 /// Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID if its stencil leaves view->nodes;
-/// AMPM_ERR_OVERFLOW if a node value it would write (old value + contribution) is not finite;
-/// the particle errors of AmpmParticles and the kernels; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW if adding it makes a node value non-finite: when a run's block would write a
+/// non-finite value, the grid is left as it was and the run's particles are added one at a time,
+/// which refuses exactly those; a run whose block sum is finite is accepted even where adding
+/// its particles one at a time would pass through a non-finite value (huge opposite
+/// contributions). The particle errors of AmpmParticles and the kernels; a failed particle
+/// writes nothing.
 /// Whole-call errors (NULL material, particles, view or a particle array the material needs;
 /// bad kernel, grid, h, impulse_dt; dims < 0; n too large): nothing written, *first_failed = 0.
 /// Threads: concurrent calls are safe when the nodes they write do not overlap.
@@ -86,12 +106,22 @@ pub unsafe extern "C" fn ampm_p2g_2d_f64(
 /// for plain momentum; dt for the symplectic-Euler form m v* + dt f, so the host needs no force
 /// channel); `particles`: reads x, v, affine, f_e, f_p, mass, volume0, temperature (THERMAL),
 /// phase (if not NULL; required with PHASE_CHANGE), latent (PHASE_CHANGE); writes nothing.
-/// Stresses use SIMD lanes of the instruction set of ampm_isa(); results do not depend on a
-/// particle's position in the batch.
+/// Stresses use SIMD lanes of the instruction set of ampm_isa(); a particle's stress and node
+/// contributions do not depend on its position in the batch.
+///
+/// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// local block first and the block is added to the grid once, so the rounding of a node value
+/// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
+/// the call fast; any order gives the same sums to rounding.
 ///
 /// Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID if its stencil leaves view->nodes;
-/// AMPM_ERR_OVERFLOW if a node value it would write (old value + contribution) is not finite;
-/// the particle errors of AmpmParticles and the kernels; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW if adding it makes a node value non-finite: when a run's block would write a
+/// non-finite value, the grid is left as it was and the run's particles are added one at a time,
+/// which refuses exactly those; a run whose block sum is finite is accepted even where adding
+/// its particles one at a time would pass through a non-finite value (huge opposite
+/// contributions). The particle errors of AmpmParticles and the kernels; a failed particle
+/// writes nothing.
 /// Whole-call errors (NULL material, particles, view or a particle array the material needs;
 /// bad kernel, grid, h, impulse_dt; dims < 0; n too large): nothing written, *first_failed = 0.
 /// Threads: concurrent calls are safe when the nodes they write do not overlap.
@@ -120,12 +150,22 @@ pub unsafe extern "C" fn ampm_p2g_3d_f32(
 /// for plain momentum; dt for the symplectic-Euler form m v* + dt f, so the host needs no force
 /// channel); `particles`: reads x, v, affine, f_e, f_p, mass, volume0, temperature (THERMAL),
 /// phase (if not NULL; required with PHASE_CHANGE), latent (PHASE_CHANGE); writes nothing.
-/// Stresses use SIMD lanes of the instruction set of ampm_isa(); results do not depend on a
-/// particle's position in the batch.
+/// Stresses use SIMD lanes of the instruction set of ampm_isa(); a particle's stress and node
+/// contributions do not depend on its position in the batch.
+///
+/// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// local block first and the block is added to the grid once, so the rounding of a node value
+/// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
+/// the call fast; any order gives the same sums to rounding.
 ///
 /// Per particle (batch contract): AMPM_ERR_OUTSIDE_GRID if its stencil leaves view->nodes;
-/// AMPM_ERR_OVERFLOW if a node value it would write (old value + contribution) is not finite;
-/// the particle errors of AmpmParticles and the kernels; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW if adding it makes a node value non-finite: when a run's block would write a
+/// non-finite value, the grid is left as it was and the run's particles are added one at a time,
+/// which refuses exactly those; a run whose block sum is finite is accepted even where adding
+/// its particles one at a time would pass through a non-finite value (huge opposite
+/// contributions). The particle errors of AmpmParticles and the kernels; a failed particle
+/// writes nothing.
 /// Whole-call errors (NULL material, particles, view or a particle array the material needs;
 /// bad kernel, grid, h, impulse_dt; dims < 0; n too large): nothing written, *first_failed = 0.
 /// Threads: concurrent calls are safe when the nodes they write do not overlap.
@@ -587,7 +627,8 @@ pub unsafe extern "C" fn ampm_force_prepare_3d_f64(
 /// operator is (A v)_i = m_i v_i − dt·df_i with df = apply(du = dt·v). With the PSD option
 /// A is symmetric positive definite wherever m_i > 0. Per particle (batch contract):
 /// AMPM_ERR_NOT_PREPARED, AMPM_ERR_OUTSIDE_GRID, AMPM_ERR_NON_FINITE for a non-finite du read,
-/// AMPM_ERR_OVERFLOW for a df that would not be finite; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW for a df that would not be finite (node sums per run of nearby particles,
+/// as ampm_p2g_2d_f32); a failed particle writes nothing.
 ///
 /// `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).
 #[no_mangle]
@@ -620,7 +661,8 @@ pub unsafe extern "C" fn ampm_force_apply_2d_f32(
 /// operator is (A v)_i = m_i v_i − dt·df_i with df = apply(du = dt·v). With the PSD option
 /// A is symmetric positive definite wherever m_i > 0. Per particle (batch contract):
 /// AMPM_ERR_NOT_PREPARED, AMPM_ERR_OUTSIDE_GRID, AMPM_ERR_NON_FINITE for a non-finite du read,
-/// AMPM_ERR_OVERFLOW for a df that would not be finite; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW for a df that would not be finite (node sums per run of nearby particles,
+/// as ampm_p2g_2d_f64); a failed particle writes nothing.
 ///
 /// `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).
 #[no_mangle]
@@ -653,7 +695,8 @@ pub unsafe extern "C" fn ampm_force_apply_2d_f64(
 /// operator is (A v)_i = m_i v_i − dt·df_i with df = apply(du = dt·v). With the PSD option
 /// A is symmetric positive definite wherever m_i > 0. Per particle (batch contract):
 /// AMPM_ERR_NOT_PREPARED, AMPM_ERR_OUTSIDE_GRID, AMPM_ERR_NON_FINITE for a non-finite du read,
-/// AMPM_ERR_OVERFLOW for a df that would not be finite; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW for a df that would not be finite (node sums per run of nearby particles,
+/// as ampm_p2g_3d_f32); a failed particle writes nothing.
 ///
 /// `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).
 #[no_mangle]
@@ -686,7 +729,8 @@ pub unsafe extern "C" fn ampm_force_apply_3d_f32(
 /// operator is (A v)_i = m_i v_i − dt·df_i with df = apply(du = dt·v). With the PSD option
 /// A is symmetric positive definite wherever m_i > 0. Per particle (batch contract):
 /// AMPM_ERR_NOT_PREPARED, AMPM_ERR_OUTSIDE_GRID, AMPM_ERR_NON_FINITE for a non-finite du read,
-/// AMPM_ERR_OVERFLOW for a df that would not be finite; a failed particle writes nothing.
+/// AMPM_ERR_OVERFLOW for a df that would not be finite (node sums per run of nearby particles,
+/// as ampm_p2g_3d_f64); a failed particle writes nothing.
 ///
 /// `n`: number of particles. `first_failed`: index of the first failed particle (n if none; 0 after a whole-call error; may be NULL).
 #[no_mangle]

@@ -15,10 +15,12 @@
 //!
 //! **Batch contract.** Every particle is processed on its own: a particle that fails writes
 //! nothing (no node value, no particle field) and the call goes on; the first failure's index
-//! and error are returned ([`BatchStatus`]). P2G and the force differential check every node
-//! value they would write (old value plus contribution) and refuse the whole particle with
-//! [`crate::Error::Overflow`] if one is not finite. A call that returns `Ok` leaves every particle
-//! in a state the next call accepts.
+//! and error are returned ([`BatchStatus`], the failure of lowest index). P2G and the force
+//! differential sum a run of consecutive nearby particles in a local node tile before adding it
+//! to the grid (see `tile.rs`); if a node value of the tile's sum would not be finite, the grid is
+//! left as it was and the run's particles are added one at a time, each checked (old value plus
+//! contribution) and refused whole with [`crate::Error::Overflow`] if a value is not finite. A
+//! call that returns `Ok` leaves every particle in a state the next call accepts.
 //!
 //! **Threads.** Calls share no state (apart from the instruction-set choice of
 //! [`crate::lane::Isa`]). Two calls may run at once if the nodes they write do not overlap: a

@@ -9,7 +9,8 @@
 //! - heat capacity `w m c`, thermal energy `w m c T`, conductivity mass `w m κ` (heat on).
 //!
 //! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
-//! node loop is per particle.
+//! node values of a run of nearby particles are summed in a node tile ([`super::tile`]) that is
+//! added to the grid once per run.
 
 use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
 use super::tile::{axis0, factors, grad_coef, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
@@ -86,7 +87,8 @@ struct Ready<T, const D: usize> {
 /// mass, volume0`, `temperature` with heat on, `phase` (if non-null).
 ///
 /// Errors per particle as [`crate::particle::update::p2g`], plus [`Error::OutsideGrid`] and
-/// [`Error::Overflow`] for a node value that would not be finite. A whole-call error (material
+/// [`Error::Overflow`] for a node value that adding the particle would make non-finite (node
+/// sums per run of nearby particles, see [`super::tile`]). A whole-call error (material
 /// flags, a null array the material needs, `impulse_dt` not finite or negative, a face axis
 /// `≥ d`) is reported for particle 0 and nothing is written.
 ///
@@ -400,7 +402,7 @@ where
     /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
     /// particle does not fit in its tile or the run is full.
     #[inline(always)]
-    unsafe fn to_tile<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
         r: &Ready<T, D>,
@@ -465,7 +467,7 @@ where
     ) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => self.to_tile::<R, K, N>(i, &r, tau_dev, tile, run, oc),
+            Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc),
         };
         self.first.note(i, r);
     }

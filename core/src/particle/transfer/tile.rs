@@ -262,10 +262,8 @@ pub(super) fn axis0<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize
     s0: usize,
 ) -> (R, R) {
     let (mut wl, mut dl) = ([T::ZERO; TILE_X], [T::ZERO; TILE_X]);
-    for o in 0..K {
-        wl[s0 + o] = s.w[0][o];
-        dl[s0 + o] = s.dw[0][o];
-    }
+    wl[s0..s0 + K].copy_from_slice(&s.w[0][..K]);
+    dl[s0..s0 + K].copy_from_slice(&s.dw[0][..K]);
     (R::load(&wl), R::load(&dl))
 }
 
