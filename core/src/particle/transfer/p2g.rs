@@ -9,7 +9,7 @@
 //! - heat capacity `w m c`, thermal energy `w m c T`, conductivity mass `w m κ` (heat on).
 //!
 //! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
-//! node values of a run of nearby particles are summed in a node tile ([`super::tile`]) that is
+//! node values of a run of nearby particles are summed in a node tile (`transfer/tile.rs`) that is
 //! added to the grid once per run.
 
 use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
@@ -88,7 +88,7 @@ struct Ready<T, const D: usize> {
 ///
 /// Errors per particle as [`crate::particle::update::p2g`], plus [`Error::OutsideGrid`] and
 /// [`Error::Overflow`] for a node value that adding the particle would make non-finite (node
-/// sums per run of nearby particles, see [`super::tile`]). A whole-call error (material
+/// sums per run of nearby particles, see `transfer/tile.rs`). A whole-call error (material
 /// flags, a null array the material needs, `impulse_dt` not finite or negative, a face axis
 /// `≥ d`) is reported for particle 0 and nothing is written.
 ///

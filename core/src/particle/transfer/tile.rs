@@ -22,9 +22,11 @@
 //! product of the other axes' weights, `c_a` the same with `∂w_a` for `w_a`) and `W`, `W'` the
 //! axis-0 weights and derivatives in their tile lanes: every channel's value is
 //! `c₀ P + Σ_{a≥1} c₀ o_a E_a + Σ_{a≥1} c_a B_a` with per-particle lane vectors `P`, `E_a`,
-//! `B_a` ([`Coef`]); e.g. momentum `w (q₀ + m C h o) + Δt_f f` gives
-//! `P = W (q₀ + (mCh)_{·0} o₀) + Δt_f W' fm_{0·}`, `E_a = W (mCh)_{·a}`, `B_a = Δt_f W fm_{a·}`.
-//! The sums are the same as the per-node ones up to the order of the additions.
+//! `B_a` ([`Coef`]); e.g. component `k` of the momentum, `w (q₀ + m C h o)_k + Δt_f f_k` with
+//! `f = fm ∇w` (`fm = −V⁰ τ`), gives `P = W (q₀ₖ + (mCh)_{k0} o₀) + Δt_f W' fm_{k0}`,
+//! `E_a = W (mCh)_{ka}`, `B_a = Δt_f W fm_{ka}`, where `o₀` is the lane's axis-0 offset from the
+//! particle's base node. The values are those of the per-node formulas up to rounding (products
+//! and sums in another order).
 //!
 //! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
 //! the old values are put back and the run's particles are added one by one by the
