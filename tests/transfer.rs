@@ -1361,9 +1361,9 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
         let poisoned = g.index([6; D]);
         g.ch[MASS][poisoned] = T::NAN;
         let mut only2 = g.clone();
-        let mut store = Store::from(&ps);
+        let mut s1 = Store::from(&ps);
         // SAFETY: six particles; the channels cover the box.
-        let st = unsafe { p2g::p2g(isa, &mat, &args, 6, &store.raw(), &g.p2g_view()) };
+        let st = unsafe { p2g::p2g(isa, &mat, &args, 6, &s1.raw(), &g.p2g_view()) };
         assert_eq!(
             (st.first_failed, st.error),
             (0, Some(Error::Overflow)),
@@ -1378,8 +1378,9 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
             only2.bits(),
             "{isa:?}: only particle 2 was written"
         );
-        // Without the poisoned node every particle is written, and the NaN velocity of a
-        // later particle does not hide an earlier failure.
+        // A later particle's own failure (NaN velocity, noted before its run is added) does
+        // not hide an earlier particle's overflow in that run; without the bad node, the NaN
+        // velocity is the first failure.
         let mut clean = DenseGrid::<T, D>::new([0; D], [16; D]);
         let mut bad = ps.clone();
         bad[4].v[1] = T::NAN;
@@ -1399,7 +1400,6 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
             (4, Some(Error::NonFinite)),
             "{isa:?}"
         );
-        let _ = &mut store;
     }
 }
 
