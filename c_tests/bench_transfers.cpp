@@ -33,6 +33,10 @@
 // Eigen baseline (elastic 3D f32): the same P2G sym + G2P loop written by hand as a host
 // would: per particle one Eigen::JacobiSVD (full U, V) for the polar decomposition of the
 // stress, the same B-spline loops, the same grid arrays, built with the flags below.
+// Hardware limit (elastic, 3D and 2D f32; c_tests/bench_floor.hpp): the memory floor (the
+// bytes of each call's interface streamed once) and the arithmetic floor (the node loops'
+// FMAs at the measured FMA rate), timed in the same run and set against the library and the
+// baseline.
 //
 // ampm.hpp (zero-cost check): the elastic 3D f32 step (zeroing + P2G sym + grid + G2P) written
 // against the C++ wrapper include/ampm.hpp (Material, Particles and view builders, ampm::p2g,
@@ -72,6 +76,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "bench_floor.hpp"
 
 namespace {
 
@@ -645,6 +651,17 @@ struct Baseline {
   double p2g = NAN, g2p = NAN;
 };
 
+/// The hardware limit of the elastic f32 step in one dimension (c_tests/bench_floor.hpp):
+/// memory floors of P2G and G2P (ns per particle) and their bytes per particle, and the
+/// arithmetic floors at the measured FMA rate.
+struct Floor {
+  int d = 0;
+  double mem_p2g = NAN, mem_g2p = NAN, bytes_p2g = NAN, bytes_g2p = NAN;
+  double fma_per_ns = NAN, fma_p2g = NAN, fma_g2p = NAN;
+  double p2g() const { return std::max(mem_p2g, fma_p2g); }
+  double g2p() const { return std::max(mem_g2p, fma_g2p); }
+};
+
 // ---- one case ------------------------------------------------------------------------------
 
 template <class T, int D>
@@ -1187,8 +1204,50 @@ std::string verdict(double got, double target) {
   return got <= target ? " ✓" : " ✗";
 }
 
-std::string report(const std::vector<Row>& rows, const Baseline& base, const HppTiming& hpp,
-                   const std::vector<std::string>& checks, int reps, std::uint32_t default_isa,
+/// The hardware-limit section of the report: per dimension, the floors against the library
+/// (default ISA) and, in 3D, the Eigen baseline, all from this run.
+std::string floor_report(const std::vector<Row>& rows, const Baseline& base, const std::vector<Floor>& floors,
+                         std::uint32_t default_isa) {
+  std::ostringstream o;
+  char buf[64];
+  o << "Hardware limit, elastic f32, measured in this run (`c_tests/bench_floor.hpp`). Memory floor: the bytes "
+       "each call's interface reads and writes (every particle array it reads, summed; every array it updates, "
+       "read and written back; the grid channels), streamed once in order. Arithmetic floor: the node loops' "
+       "fused multiply-adds alone (per node 2 + 3d + d² for P2G, d(1 + 2d) for G2P; constitutive model, "
+       "weights and checks not counted) at the FMA rate measured on independent accumulators";
+  if (!floors.empty()) {
+    std::snprintf(buf, sizeof buf, " (%.0f f32 FMAs per ns)", floors.front().fma_per_ns);
+    o << buf;
+  }
+  o << ". The floor is the larger of the two; no implementation of these calls can be faster on this machine.\n\n";
+  o << "| | P2G sym | G2P | P2G + G2P | × floor |\n|---|---:|---:|---:|---:|\n";
+  for (const Floor& f : floors) {
+    const std::string kase = std::to_string(f.d) + "D f32";
+    const Row* lib = nullptr;
+    for (const Row& r : rows)
+      if (r.isa == isa_name(default_isa) && r.kase == kase && r.scene == std::string("elastic")) lib = &r;
+    const double floor = f.p2g() + f.g2p();
+    auto line = [&](const std::string& what, double p2g, double g2p) {
+      std::snprintf(buf, sizeof buf, "%.1f", (p2g + g2p) / floor);
+      o << "| " << kase << " " << what << " | " << fmt(p2g) << " | " << fmt(g2p) << " | " << fmt(p2g + g2p) << " | "
+        << buf << " |\n";
+    };
+    std::snprintf(buf, sizeof buf, "%.0f / %.0f", f.bytes_p2g, f.bytes_g2p);
+    line(std::string("memory floor (") + buf + " B per particle)", f.mem_p2g, f.mem_g2p);
+    line("arithmetic floor (node loops)", f.fma_p2g, f.fma_g2p);
+    line("**floor**", f.p2g(), f.g2p());
+    if (lib) line(std::string("library (") + isa_name(default_isa) + ")", lib->p2g_sym, lib->g2p);
+    if (f.d == 3) line("Eigen baseline", base.p2g, base.g2p);
+    std::snprintf(buf, sizeof buf, "%.1f", f.d == 3 ? 100 / floor : 30 / floor);
+    o << "| " << kase << " target (" << (f.d == 3 ? 100 : 30) << " ns) | | | " << (f.d == 3 ? 100 : 30) << " | " << buf
+      << " |\n";
+  }
+  o << "\n";
+  return o.str();
+}
+
+std::string report(const std::vector<Row>& rows, const Baseline& base, const std::vector<Floor>& floors,
+                   const HppTiming& hpp, const std::vector<std::string>& checks, int reps, std::uint32_t default_isa,
                    const std::string& load_before) {
   std::ostringstream o;
   o << "# ampm particle transfers in a host's step loop\n\n";
@@ -1242,6 +1301,7 @@ std::string report(const std::vector<Row>& rows, const Baseline& base, const Hpp
   std::snprintf(ratio, sizeof ratio, "%.2f", (base.p2g + base.g2p) / lib_elastic);
   o << "| Eigen baseline | " << fmt(base.p2g) << " | " << fmt(base.g2p) << " | " << fmt(base.p2g + base.g2p) << " | "
     << ratio << " |\n\n";
+  o << floor_report(rows, base, floors, default_isa);
   o << "C++ wrapper `include/ampm.hpp`, elastic 3D f32 (" << hpp.n << " particles, " << isa_name(default_isa)
     << "): the step (zeroing + P2G sym + grid + G2P) through `ampm::p2g` / `ampm::g2p_update` with the "
        "builders made per call, against the same step through the C calls, alternating rep by rep.\n\n";
@@ -1277,6 +1337,32 @@ Baseline time_baseline(int per_axis, int reps) {
   grid_update(cs.g, false);
   b.g2p = median_ns(reps, cs.p.n, [&] { cs.restore(); }, [&] { eigen_g2p<float, 3>(cs.p, cs.g, cs.h, cs.dt); });
   return b;
+}
+
+template <int D>
+Floor time_floor(int per_axis, int reps, double fma_per_ns) {
+  Case<float, D> cs(Scene::Elastic, per_axis);
+  auto& p = cs.p;
+  auto& g = cs.g;
+  // The arrays the elastic calls read and write (include/ampm.h): P2G reads every particle
+  // array and adds into mass and momentum; G2P reads mass, volume and the node velocities,
+  // and updates x, v, affine, F_E, F_P.
+  bench_floor::Streams<float> p2g{{&p.x, &p.v, &p.c, &p.fe, &p.fp, &p.m, &p.v0}, {&g.mass}};
+  bench_floor::Streams<float> g2p{{&p.m, &p.v0}, {&p.x, &p.v, &p.c, &p.fe, &p.fp}};
+  for (int a = 0; a < D; ++a) p2g.update.push_back(&g.mom[a]), g2p.read.push_back(&g.vel[a]);
+  volatile float one_v = 1.0f;
+  const float one = one_v;
+  Floor f;
+  f.d = D;
+  const auto n = static_cast<double>(p.n);
+  f.bytes_p2g = static_cast<double>(p2g.bytes()) / n;
+  f.bytes_g2p = static_cast<double>(g2p.bytes()) / n;
+  f.mem_p2g = median_ns(reps, p.n, [] {}, [&] { bench_floor::stream(p2g, one); });
+  f.mem_g2p = median_ns(reps, p.n, [] {}, [&] { bench_floor::stream(g2p, one); });
+  f.fma_per_ns = fma_per_ns;
+  f.fma_p2g = bench_floor::p2g_fmas(D) / fma_per_ns;
+  f.fma_g2p = bench_floor::g2p_fmas(D) / fma_per_ns;
+  return f;
 }
 
 [[noreturn]] void usage(int code) {
@@ -1347,10 +1433,15 @@ int main(int argc, char** argv) {
   }
   ampm_set_isa(default_isa);
   const Baseline base = time_baseline(n3, reps);
+  const double fma_rate = bench_floor::fma_per_ns(reps);
+  const std::vector<Floor> floors{time_floor<3>(n3, reps, fma_rate), time_floor<2>(n2, reps, fma_rate)};
+  for (const Floor& f : floors)
+    std::fprintf(stderr, "floor %dD f32: memory P2G %.1f G2P %.1f ns (%.0f / %.0f B), arithmetic %.1f / %.1f ns\n", f.d,
+                 f.mem_p2g, f.mem_g2p, f.bytes_p2g, f.bytes_g2p, f.fma_p2g, f.fma_g2p);
   const HppTiming hpp = time_hpp(n3, reps);
   std::fprintf(stderr, "ampm.hpp elastic 3D f32 step: C %.1f ns, ampm.hpp %.1f ns, ratio %.3f (fastest %.3f)\n", hpp.c,
                hpp.hpp, hpp.hpp / hpp.c, hpp.hpp_min / hpp.c_min);
-  const std::string text = report(rows, base, hpp, log.lines, reps, default_isa, load_before);
+  const std::string text = report(rows, base, floors, hpp, log.lines, reps, default_isa, load_before);
   std::fputs(text.c_str(), stdout);
   std::ofstream f(out);
   f << text;
