@@ -52,6 +52,12 @@
  * ampm_set_isa, which should be set once at start-up, before other threads call the library.
  * Concurrent calls are safe when no call writes memory that another call reads or writes.
  *
+ * Stack. Calls run on the calling thread's stack: the kernels (single and ampm_*_batch) use at
+ * most 32 KiB of it, the particle calls (P2G, G2P, force prepare and apply) at most 96 KiB. The
+ * largest measured is about 64 KiB, P2G in 3D f64 with every channel, which sums node values
+ * in local tiles (c_tests/test_stack measures every call on every instruction set). Run the
+ * particle calls on threads or fibers with at least 96 KiB of stack.
+ *
  * Instruction sets. Batch calls run on the widest instruction set the CPU supports (AVX-512F,
  * AVX2 + FMA, or scalar), detected at first use; ampm_set_isa chooses another (AMPM_ISA_*)
  * and ampm_isa tells which is in use. Results are identical on the AVX2 and AVX-512 paths;
