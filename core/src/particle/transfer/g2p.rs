@@ -11,7 +11,7 @@
 //! per-node subtraction.
 
 use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes};
-use super::{BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
+use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
@@ -144,41 +144,52 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`), in chunks of
+    /// [`CHUNK`] particles: first every grid sample of the chunk (stencil and node sums, which
+    /// read only the position), then every update. Each half is a short loop whose iterations
+    /// do not depend on each other, so the processor overlaps consecutive particles' latency
+    /// chains (one particle's whole G2P is longer than its out-of-order window). The statuses
+    /// are those of the one-particle order: the particle's own checks come before its sample's.
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
-        for i in 0..self.n {
-            // SAFETY: `g2p_update`'s contract.
-            let r = unsafe {
-                one::<T, R, D, K, N>(
-                    self.material,
-                    &self.checked,
-                    self.args,
-                    self.ps,
-                    self.view,
-                    self.faces,
-                    &cst,
-                    i,
-                )
-            };
-            first.note(i, r);
+        let mut start = 0;
+        while start < self.n {
+            let len = CHUNK.min(self.n - start);
+            let mut samples = [Err(Error::NonFinite); CHUNK];
+            for (k, out) in samples.iter_mut().enumerate().take(len) {
+                // SAFETY: `g2p_update`'s contract (particle `start + k < n`).
+                *out = unsafe {
+                    let x = rd_vec::<T, D>(self.ps.x, start + k);
+                    sample::<T, R, D, K, N>(self.material, self.args, &x, self.view, self.faces, &cst)
+                };
+            }
+            for (k, smp) in samples.iter().enumerate().take(len) {
+                // SAFETY: as above.
+                let r = unsafe {
+                    update_one(self.material, &self.checked, self.args, self.ps, smp, start + k)
+                };
+                first.note(start + k, r);
+            }
+            start += len;
         }
         first.status()
     }
 }
 
-#[allow(clippy::too_many_arguments)]
+/// Particles per chunk of [`G2pOp::run_nodes`].
+const CHUNK: usize = 8;
+
+/// The update of particle `i` from its grid sample (or the sample's error): the particle's
+/// checks, then the sample's status, then [`update_validated`] and the position limit.
 #[inline(always)]
-unsafe fn one<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+unsafe fn update_one<T: Real, const D: usize>(
     material: &Material<T>,
     checked: &Checked,
     args: &G2pArgs<T>,
     ps: &Particles<T>,
-    view: &G2pView<T, D>,
-    faces: Option<&[G2pView<T, D>; D]>,
-    cst: &[[T; 8]; N],
+    sample: &Result<G2pSample<T, D>>,
     i: usize,
 ) -> Result<()>
 where
@@ -192,7 +203,7 @@ where
     };
     let p = ps.get::<D>(i, reads, material)?;
     checked.for_phase(p.phase)?;
-    let sample = sample::<T, R, D, K, N>(material, args, &p.x, view, faces, cst)?;
+    let sample = (*sample)?;
     // The material was validated for this phase above (`checked`).
     let (out, _) = update_validated(material, args.dt, &sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
