@@ -109,10 +109,27 @@ pub fn evolve<T: Real, const D: usize>(
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
+    let (f, k, _) = evolve_det(f_e, grad_v, dt)?;
+    Ok((f, k))
+}
+
+/// [`evolve`], also returning the new `J_E = det F_E` that its check computed (finite,
+/// positive).
+///
+/// Errors: as [`evolve`].
+#[inline]
+pub fn evolve_det<T: Real, const D: usize>(
+    f_e: &Mat<T, D>,
+    grad_v: &Mat<T, D>,
+    dt: T,
+) -> Result<(Mat<T, D>, u32, T)>
+where
+    Mat<T, D>: Matrix<Scalar = T>,
+{
     let (a, k) = increment(grad_v, dt)?;
     let f = a * *f_e;
-    check_det(&f)?;
-    Ok((f, k))
+    let j = check_det(&f)?;
+    Ok((f, k, j))
 }
 
 /// Snow plasticity: returns `(F_E, F_P)` after clamping the singular values of `f_e` to

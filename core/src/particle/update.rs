@@ -26,7 +26,7 @@
 //! step refuses.
 
 use super::apic::{self, gather};
-use super::deformation::{check_det, evolve, liquid_projection, snow_plasticity};
+use super::deformation::{check_det, evolve_det, liquid_projection, snow_plasticity};
 use super::dilation;
 use super::stencil::{Grid, Kernel, Stencil};
 use super::thermal::{self, HeatSplit, ThermalState};
@@ -340,12 +340,13 @@ pub struct G2pSample<T, const D: usize> {
 }
 
 /// The input checks of [`update_particle`] but the temperature: material, particle, `Δt`.
+/// Returns `J_P` ([`check_particle`]).
 #[inline]
 fn check_update_inputs<T: Real, const D: usize>(
     material: &Material<T>,
     dt: T,
     p: &Particle<T, D>,
-) -> Result<()>
+) -> Result<T>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
@@ -353,20 +354,20 @@ where
     check_particle_dt(p, dt)
 }
 
-/// The particle and `Δt` checks of [`update_particle`].
+/// The particle and `Δt` checks of [`update_particle`]. Returns `J_P` ([`check_particle`]).
 #[inline(always)]
-fn check_particle_dt<T: Real, const D: usize>(p: &Particle<T, D>, dt: T) -> Result<()>
+fn check_particle_dt<T: Real, const D: usize>(p: &Particle<T, D>, dt: T) -> Result<T>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
-    check_particle(p)?;
+    let (_, j_p) = check_particle(p)?;
     if !dt.is_finite() {
         return Err(Error::NonFinite);
     }
     if dt <= T::ZERO {
         return Err(Error::InvalidArgument);
     }
-    Ok(())
+    Ok(j_p)
 }
 
 /// The particle's temperature, read when heat is on.
@@ -416,9 +417,9 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    check_update_inputs(material, dt, p)?;
+    let j_p = check_update_inputs(material, dt, p)?;
     check_temperature(material, p)?;
-    update_checked(material, dt, s, p)
+    update_checked(material, dt, s, p, j_p)
 }
 
 /// [`update_particle`] for a caller that has validated the material for the particle's phase
@@ -435,18 +436,20 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    check_particle_dt(p, dt)?;
+    let j_p = check_particle_dt(p, dt)?;
     check_temperature(material, p)?;
-    update_checked(material, dt, s, p)
+    update_checked(material, dt, s, p, j_p)
 }
 
-/// [`update_particle`] after its input checks ([`check_update_inputs`], the temperature).
+/// [`update_particle`] after its input checks ([`check_update_inputs`], the temperature), which
+/// gave `j_p = det F_P`.
 #[inline(always)]
 fn update_checked<T: Real, const D: usize>(
     material: &Material<T>,
     dt: T,
     s: &G2pSample<T, D>,
     p: &Particle<T, D>,
+    j_p: T,
 ) -> Result<(Particle<T, D>, UpdateInfo<T>)>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -505,31 +508,51 @@ where
     }
 
     // 3. Elastic deformation gradient, with the remedy.
-    let (f_e, k) = evolve(&p.f_e, &s.grad_v, dt)?;
+    let (f_e, k, j_e) = evolve_det(&p.f_e, &s.grad_v, dt)?;
     info.halvings = k;
 
-    // 4. Liquid projection or plasticity.
-    let (f_e, f_p) = match (out.phase, &material.plasticity) {
-        (Phase::Liquid, _) => liquid_projection(&f_e, &p.f_p)?,
-        (Phase::Solid, Some(snow)) => snow_plasticity(snow, &f_e, &p.f_p)?,
-        (Phase::Solid, None) => (f_e, p.f_p),
+    // 4. Liquid projection or plasticity. A kept `F_P` keeps its checked `J_P`.
+    let (f_e, f_p, kept) = match (out.phase, &material.plasticity) {
+        (Phase::Liquid, _) => {
+            let (fe, fp) = liquid_projection(&f_e, &p.f_p)?;
+            (fe, fp, None)
+        }
+        (Phase::Solid, Some(snow)) => {
+            let (fe, fp) = snow_plasticity(snow, &f_e, &p.f_p)?;
+            (fe, fp, None)
+        }
+        (Phase::Solid, None) => (f_e, p.f_p, Some((j_e, j_p))),
     };
     out.f_e = f_e;
     out.f_p = f_p;
 
-    check_result(material, &out)?;
+    check_result(material, &out, kept)?;
     Ok((out, info))
 }
 
 /// Checks a new particle as the next entry will check it, with the statuses of a result:
 /// a non-finite value or a determinant that under- or overflows is [`Error::Overflow`]
 /// ([`check_det`]), a singular `F_E` or `F_P` [`Error::NonPositiveJ`].
+///
+/// `known = Some((J_E, J_P))` when the caller has established what [`check_particle`] would
+/// return: `x`, `v`, `affine` checked finite, `F_E` from [`evolve_det`] (finite, `J_E` its
+/// positive finite determinant), `F_P`, mass and volume the input's, `J_P` its checked
+/// determinant. Then only the temperature, phase and moduli checks are left.
 #[inline]
-fn check_result<T: Real, const D: usize>(material: &Material<T>, p: &Particle<T, D>) -> Result<()>
+fn check_result<T: Real, const D: usize>(
+    material: &Material<T>,
+    p: &Particle<T, D>,
+    known: Option<(T, T)>,
+) -> Result<()>
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
-    let j_p = match check_particle(p) {
+    let checked = match known {
+        Some(j) => Ok(j),
+        None => check_particle(p),
+    };
+    debug_assert!(known.is_none() || check_particle(p) == checked);
+    let j_p = match checked {
         Ok((_, j_p)) => j_p,
         Err(Error::NonFinite) => return Err(Error::Overflow),
         Err(Error::NonPositiveJ) => {
@@ -584,7 +607,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    check_update_inputs(material, dt, p)?;
+    let j_p = check_update_inputs(material, dt, p)?;
     let stencil = Stencil::new(kernel, Grid::Collocated, h, &p.x)?;
     let (t_pic, t_flip) = match material.heat {
         Some(_) => {
@@ -602,7 +625,7 @@ where
         t_pic,
         t_flip,
     };
-    let (out, info) = update_checked(material, dt, &sample, p)?;
+    let (out, info) = update_checked(material, dt, &sample, p, j_p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, h, &out.x).is_err() {
         // The cell index of the new position is beyond the supported range.
         return Err(Error::Overflow);

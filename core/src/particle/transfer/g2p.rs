@@ -162,13 +162,27 @@ where
                 // SAFETY: `g2p_update`'s contract (particle `start + k < n`).
                 *out = unsafe {
                     let x = rd_vec::<T, D>(self.ps.x, start + k);
-                    sample::<T, R, D, K, N>(self.material, self.args, &x, self.view, self.faces, &cst)
+                    sample::<T, R, D, K, N>(
+                        self.material,
+                        self.args,
+                        &x,
+                        self.view,
+                        self.faces,
+                        &cst,
+                    )
                 };
             }
             for (k, smp) in samples.iter().enumerate().take(len) {
                 // SAFETY: as above.
                 let r = unsafe {
-                    update_one(self.material, &self.checked, self.args, self.ps, smp, start + k)
+                    update_one(
+                        self.material,
+                        &self.checked,
+                        self.args,
+                        self.ps,
+                        smp,
+                        start + k,
+                    )
                 };
                 first.note(start + k, r);
             }
