@@ -1,7 +1,9 @@
-//! Quick split timing of P2G and G2P (3D f32 quadratic): `cargo run --release -p ampm-tools
+//! Quick split timing of P2G, G2P and the force differential's apply (3D f32 quadratic): `cargo run --release -p ampm-tools
 //! --example transfer_timing -- <fluid|elastic>` (a development aid; the benchmark is
 //! `tools/benches/particle_levels.rs`).
 use ampm_core::lane::Isa;
+use ampm_core::particle::implicit::slot_len;
+use ampm_core::particle::transfer::force::{self, ForceView};
 use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
 use ampm_core::particle::transfer::{Channel, NodeBox, Particles};
@@ -124,8 +126,44 @@ fn main() {
             .ok()
             .and_then(|r| r.parse().ok())
             .unwrap_or(10);
-        let mut best = (f64::MAX, f64::MAX);
+        let mut best = (f64::MAX, f64::MAX, f64::MAX);
+        // The force differential, prepared once from the initial state.
+        let mut slots = vec![0.0f32; n * slot_len(D)];
+        // SAFETY: n particles, slots sized for them.
+        let st = unsafe { force::prepare::<f32, D>(isa, &mat, n, &ps, slots.as_mut_ptr()) };
+        assert_eq!(st.error, None);
+        let x0 = x.clone();
+        let du = vec![vec![1e-6f32; nn]; D];
+        let mut df = vec![vec![0.0f32; nn]; D];
         for _ in 0..reps {
+            df.iter_mut()
+                .for_each(|c| c.iter_mut().for_each(|x| *x = 0.0));
+            let fv = ForceView {
+                nodes,
+                du: [0, 1, 2].map(|c| Channel {
+                    data: du[c].as_ptr(),
+                    stride,
+                }),
+                df: [0, 1, 2].map(|c| Channel {
+                    data: df[c].as_mut_ptr(),
+                    stride,
+                }),
+            };
+            let t0 = Cpu::now();
+            // SAFETY: n positions and slots, channels cover the box, df does not alias du.
+            let st = unsafe {
+                force::apply(
+                    isa,
+                    Kernel::Quadratic,
+                    h,
+                    n,
+                    x0.as_ptr(),
+                    slots.as_ptr(),
+                    &fv,
+                )
+            };
+            let t3 = t0.elapsed().as_secs_f64();
+            assert_eq!(st.error, None);
             for c in grid.iter_mut() {
                 c.iter_mut().for_each(|x| *x = 0.0);
             }
@@ -171,13 +209,14 @@ fn main() {
             let st = unsafe { g2p::g2p_update(isa, &mat, &gargs, n, &ps, &gv, None) };
             let t2 = t0.elapsed().as_secs_f64();
             assert_eq!(st.error, None);
-            best = (best.0.min(t1), best.1.min(t2));
+            best = (best.0.min(t1), best.1.min(t2), best.2.min(t3));
         }
         println!(
-            "{level} {}: p2g {:.1} ns, g2p {:.1} ns per particle (best of {reps})",
+            "{level} {}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
             isa.name(),
             best.0 / n as f64 * 1e9,
-            best.1 / n as f64 * 1e9
+            best.1 / n as f64 * 1e9,
+            best.2 / n as f64 * 1e9
         );
     }
 }
