@@ -25,20 +25,12 @@
 #include <vector>
 
 #include "ampm.hpp"
+#include "common.hpp"
 
 namespace {
 
-long g_checks = 0, g_failures = 0;
-#define CHECK(cond, ...)                                                   \
-  do {                                                                     \
-    ++g_checks;                                                            \
-    if (!(cond)) {                                                         \
-      ++g_failures;                                                        \
-      std::fprintf(stderr, "%s:%d: FAIL %s: ", __FILE__, __LINE__, #cond); \
-      std::fprintf(stderr, __VA_ARGS__);                                   \
-      std::fputc('\n', stderr);                                            \
-    }                                                                      \
-  } while (0)
+ampm_test::Checker g_ck;
+#define CHECK(...) AMPM_CHECK(g_ck, __VA_ARGS__)
 
 constexpr std::size_t kKernelBound = 32 * 1024;    // kernels, single and batch, as include/ampm.h states
 constexpr std::size_t kParticleBound = 96 * 1024;  // p2g, g2p_update, force_prepare/apply
@@ -94,7 +86,7 @@ struct Scene {
   std::vector<T> mu, f, z, ahat, chat_z, prepared, applied;
   ampm::Material<T> mat;
 
-  Scene(std::size_t per_axis, unsigned k) : kernel(k) {
+  Scene(std::size_t per_axis, unsigned kern) : kernel(kern) {
     n = 1;
     for (int a = 0; a < D; ++a) n *= per_axis;
     x.resize(n * D), v.resize(n * D), c.assign(n * kM, 0), fe.assign(n * kM, 0), fp.assign(n * kM, 0);
@@ -249,7 +241,7 @@ int main() {
     (void)frame[0];
   });
   CHECK(big >= baseline + kFrame - 512, "a %zu-byte frame measured as %zu", kFrame, big);
-  std::printf("test_stack: %ld checks, %ld failures; largest call %zu bytes, %d instruction sets\n", g_checks,
-              g_failures, worst, isas);
-  return g_failures == 0 ? 0 : 1;
+  std::printf("test_stack: largest call %zu bytes, %d instruction sets\n", worst, isas);
+  g_ck.summary("test_stack");
+  return g_ck.exit_code();
 }
