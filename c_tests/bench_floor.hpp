@@ -1,6 +1,9 @@
 // The hardware limit of a transfer step, measured in the run that times the library
-// (c_tests/bench_transfers.cpp): lower bounds on the time of P2G and G2P that no implementation
-// of the same interface can beat on this machine.
+// (c_tests/bench_transfers.cpp): lower bounds on the time of P2G and G2P for any implementation
+// of the same interface on this machine.
+//
+// Both are floors in practice, not proofs: an implementation of these calls has to move these
+// bytes and do at least these multiply-adds, at rates a simple loop reaches on this machine.
 //
 // Memory floor: the bytes a call's interface reads and writes, each array streamed once in
 // order at the rate this machine sustains (every particle array the call reads, summed; every
@@ -19,7 +22,9 @@
 // Nodes per particle: 3^d (quadratic).
 #pragma once
 
+#if defined(__x86_64__) || defined(__i386__)
 #include <immintrin.h>
+#endif
 
 #include <chrono>
 #include <cstddef>
@@ -96,13 +101,20 @@ inline double fma_per_ns(int reps) {
   auto fma = [](V a, V b, V c) { return _mm256_fmadd_ps(a, b, c); };
   auto splat = [](float x) { return _mm256_set1_ps(x); };
   auto lane0 = [](V a) { return _mm256_cvtss_f32(a); };
-#else
+#elif defined(__SSE__)
   using V = __m128;
   constexpr int kLanes = 4;
   // No FMA: a multiply and an add per lane (counted as one fused operation).
   auto fma = [](V a, V b, V c) { return _mm_add_ps(_mm_mul_ps(a, b), c); };
   auto splat = [](float x) { return _mm_set1_ps(x); };
   auto lane0 = [](V a) { return _mm_cvtss_f32(a); };
+#else
+  // Not x86: scalar multiply-adds (the compiler may vectorise the accumulators).
+  using V = float;
+  constexpr int kLanes = 1;
+  auto fma = [](V a, V b, V c) { return a * b + c; };
+  auto splat = [](float x) { return x; };
+  auto lane0 = [](V a) { return a; };
 #endif
   constexpr int kAcc = 16;  // enough independent chains for two FMA ports of latency 4–6
   constexpr long kIters = 400'000;

@@ -1219,7 +1219,8 @@ std::string floor_report(const std::vector<Row>& rows, const Baseline& base, con
     std::snprintf(buf, sizeof buf, " (%.0f f32 FMAs per ns)", floors.front().fma_per_ns);
     o << buf;
   }
-  o << ". The floor is the larger of the two; no implementation of these calls can be faster on this machine.\n\n";
+  o << ". The floor is the larger of the two: any implementation of these calls moves these bytes and does at least "
+       "these multiply-adds, so it cannot be much faster than the floor on this machine.\n\n";
   o << "| | P2G sym | G2P | P2G + G2P | × floor |\n|---|---:|---:|---:|---:|\n";
   for (const Floor& f : floors) {
     const std::string kase = std::to_string(f.d) + "D f32";
