@@ -22,6 +22,7 @@
 #include <cstring>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "ampm.hpp"
@@ -133,8 +134,10 @@ struct Scene {
     p.x(x).v(v).affine(c).f_e(fe).f_p(fp).mass(m).volume0(v0).temperature(t).latent(u).phase(ph);
     return p;
   }
-  static std::array<T*, D> ptrs(std::vector<T> (&a)[D]) {
-    std::array<T*, D> r{};
+  /// The data pointers of per-axis arrays, as `T*` (outputs) or `const T*` (inputs).
+  template <class P = T*>
+  static std::array<P, D> ptrs(std::vector<T> (&a)[D]) {
+    std::array<P, D> r{};
     for (int k = 0; k < D; ++k) r[static_cast<std::size_t>(k)] = a[k].data();
     return r;
   }
@@ -175,18 +178,13 @@ struct Scene {
     });
     r.emplace_back("force_prepare", pb, [this] { return ampm::force_prepare(mat, particles(), ampm::span<T>(slots)).ok(); });
     r.emplace_back("force_apply", pb, [this] {
-      const auto view = ampm::ForceView<T, D>::separate(box, ptrs_const(du), ptrs(df));
+      const auto view = ampm::ForceView<T, D>::separate(box, ptrs<const T*>(du), ptrs(df));
       return ampm::force_apply(kernel, h, particles(), ampm::span<const T>(slots), view).ok();
     });
     r.emplace_back("g2p_update (heat)", pb, [this] {
-      const auto view = ampm::G2pView<T, D>::separate(box, ptrs_const(vel), tn.data(), to.data());
+      const auto view = ampm::G2pView<T, D>::separate(box, ptrs<const T*>(vel), tn.data(), to.data());
       return ampm::g2p_update(mat, kernel, h, dt, particles(), view).ok();
     });
-    return r;
-  }
-  static std::array<const T*, D> ptrs_const(std::vector<T> (&a)[D]) {
-    std::array<const T*, D> r{};
-    for (int k = 0; k < D; ++k) r[static_cast<std::size_t>(k)] = a[k].data();
     return r;
   }
 };
