@@ -804,6 +804,123 @@ where
     }
 }
 
+/// G2P of a whole batch gives the bits of calls of one particle each, on every instruction set
+/// and material: the batch updates chunks of plain elastic particles on SIMD lanes, a call of
+/// one particle updates it alone (the scalar update). The batch mixes chunks that stay on
+/// lanes with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
+/// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node
+/// velocity), and a liquid particle among solids.
+fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let h = T::from_f64(hf);
+    let dt = T::from_f64(1e-3);
+    for isa in Isa::available() {
+        for (name, mat) in materials::<T>() {
+            let mut rng = Pcg64::seed_from_u64(11);
+            let mut ps = particles::<T, D>(&mut rng, 75, hf, cells, &mat);
+            ps[9].f_p.cols[0][0] = T::from_f64(f64::NAN);
+            ps[20].f_e = Mat::identity();
+            ps[20].f_e.cols[0][0] = -T::ONE;
+            ps[37].phase = Phase::Liquid;
+            let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
+            let mut r2 = Pcg64::seed_from_u64(12);
+            for k in 0..g.ch[0].len() {
+                for a in 0..D {
+                    g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
+                }
+                g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+                g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+            }
+            // Around particle 50: node velocities along axis 0 converging at 2000 m/s per
+            // cell, so that ∂v₀/∂x₀ ≈ −2000/h and det(I + Δt∇v) ≈ 1 − 2000·Δt/h < 0.
+            let s50 = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &ps[50].x).unwrap();
+            for nd in s50.nodes() {
+                let k = g.index(nd.index);
+                let o = nd.index[0] - s50.base[0] - 1;
+                g.ch[MOM][k] = T::from_f64(-2000.0 * f64::from(o));
+                for a in 1..D {
+                    g.ch[MOM + a][k] = T::ZERO;
+                }
+            }
+            let args = G2pArgs {
+                kernel: Kernel::Quadratic,
+                h,
+                dt,
+            };
+            let mut batch = Store::from(&ps);
+            let raw = batch.raw();
+            // SAFETY: the arrays hold the particles; the grid covers their stencils.
+            let st =
+                unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
+            let mut one = Store::from(&ps);
+            let mut first = None;
+            for i in 0..ps.len() {
+                let r = one.raw();
+                // SAFETY: particle `i` of the arrays, as one particle.
+                let st1 = unsafe {
+                    let at = Particles {
+                        x: r.x.add(D * i),
+                        v: r.v.add(D * i),
+                        affine: r.affine.add(D * D * i),
+                        f_e: r.f_e.add(D * D * i),
+                        f_p: r.f_p.add(D * D * i),
+                        mass: r.mass.add(i),
+                        volume0: r.volume0.add(i),
+                        temperature: r.temperature.add(i),
+                        latent: r.latent.add(i),
+                        phase: r.phase.add(i),
+                    };
+                    g2p::g2p_update(isa, &mat, &args, 1, &at, &g.g2p_view(), None)
+                };
+                if let (None, Some(e)) = (first, st1.error) {
+                    first = Some((i, e));
+                }
+            }
+            assert_eq!(
+                first.map(|f| f.0).unwrap_or(ps.len()),
+                st.first_failed,
+                "{name} {isa:?}"
+            );
+            assert_eq!(first.map(|f| f.1), st.error, "{name} {isa:?}");
+            assert!(first.is_some(), "{name}: the NaN particle fails");
+            let bits = |s: &Store<T>| -> Vec<u64> {
+                [
+                    &s.x,
+                    &s.v,
+                    &s.affine,
+                    &s.f_e,
+                    &s.f_p,
+                    &s.temperature,
+                    &s.latent,
+                ]
+                .iter()
+                .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
+                .chain(s.phase.iter().map(|&c| u64::from(c)))
+                .collect()
+            };
+            assert_eq!(bits(&batch), bits(&one), "{name} {isa:?}");
+        }
+    }
+}
+
+#[test]
+fn g2p_chunks_match_single_2d_f32() {
+    g2p_chunks_match_single::<f32, 2>();
+}
+#[test]
+fn g2p_chunks_match_single_3d_f32() {
+    g2p_chunks_match_single::<f32, 3>();
+}
+#[test]
+fn g2p_chunks_match_single_3d_f64() {
+    g2p_chunks_match_single::<f64, 3>();
+}
+
 #[test]
 fn g2p_matches_reference_2d_f32() {
     g2p_matches::<f32, 2>();

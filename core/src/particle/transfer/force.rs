@@ -8,8 +8,9 @@
 //! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
+use super::nodes::NodeVals;
 use super::nodes::{add, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes};
-use super::tile::{axis0, factors, grad_coef, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
+use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
@@ -298,7 +299,6 @@ where
         let mut tile = Tile::<R, D>::new();
         let mut run = [0usize; MAX_RUN];
         let mut nrun = 0;
-        let outs = &self.view.df;
         for i in 0..self.n {
             // SAFETY: `apply`'s contract. (A `match`, not a closure: a closure is not always
             // inlined into the caller's target features.)
@@ -325,15 +325,11 @@ where
                 }
             };
             let (w, dw) = axis0::<T, R, D, K>(&s, sp[0]);
-            let mut coef = [Coef {
-                p: R::splat(T::ZERO),
-                e: None,
-                b: None,
-            }; MAX_CH];
-            for (a, c) in coef.iter_mut().enumerate().take(D) {
-                *c = grad_coef(w, dw, &m, a, T::ONE);
+            let mut coef = [Coef::only(R::splat(T::ZERO)); D];
+            for (a, c) in coef.iter_mut().enumerate() {
+                set_grad(c, w, dw, &m, a, T::ONE);
             }
-            tile.add::<K, N>(&sp, &factors::<T, D, K, N>(&s), &coef, outs.len());
+            tile.add::<K, N>(&sp, &factors::<T, D, K, N>(&s), &coef);
             run[nrun] = i;
             nrun += 1;
         }
@@ -400,7 +396,7 @@ unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     view: &ForceView<T, D>,
     cst: &[[T; 8]; N],
 ) -> Result<Mat<T, D>> {
-    let mut u = [[T::ZERO; N]; D];
+    let mut u = [NodeVals::<T, N>::new(); D];
     let mut chk = true;
     for a in 0..D {
         let c = &view.du[a];
@@ -414,7 +410,7 @@ unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     let mut sum = [R::splat(T::ZERO); D];
     for j in 0..N {
         for a in 0..D {
-            sum[a] += R::splat(u[a][j]) * m[j];
+            sum[a] += R::splat(u[a].v[j]) * m[j];
         }
     }
     let mut g = Mat::<T, D>::ZERO;

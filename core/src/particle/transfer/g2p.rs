@@ -10,7 +10,8 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes};
+use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes, NodeVals};
+use super::update_lanes::{self, ChunkSamples};
 use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
@@ -18,7 +19,7 @@ use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::{update_validated, G2pSample};
-use crate::particle::Material;
+use crate::particle::{Material, Phase};
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
 
@@ -154,10 +155,15 @@ where
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
+        // Chunks of plain elastic particles are updated on the row type's eight lanes.
+        let lanes = update_lanes::plain(self.material) && R::LANES == CHUNK;
+        let solid_ok = self.checked.for_phase(Phase::Solid).is_ok();
+        let mut cs = ChunkSamples::new();
         let mut start = 0;
         while start < self.n {
             let len = CHUNK.min(self.n - start);
             let mut samples = [Err(Error::NonFinite); CHUNK];
+            let mut all_ok = true;
             for (k, out) in samples.iter_mut().enumerate().take(len) {
                 // SAFETY: `g2p_update`'s contract (particle `start + k < n`).
                 *out = unsafe {
@@ -171,6 +177,29 @@ where
                         &cst,
                     )
                 };
+                match out {
+                    Ok(smp) if lanes => cs.set(k, smp),
+                    _ => all_ok = false,
+                }
+            }
+            // SAFETY: as above; `plain(material)` when `lanes`.
+            if lanes
+                && len == CHUNK
+                && all_ok
+                && unsafe {
+                    update_lanes::update::<T, R, D>(
+                        self.material,
+                        solid_ok,
+                        self.args.dt,
+                        self.args.h,
+                        self.ps,
+                        start,
+                        &cs,
+                    )
+                }
+            {
+                start += len;
+                continue;
             }
             for (k, smp) in samples.iter().enumerate().take(len) {
                 // SAFETY: as above.
@@ -192,8 +221,8 @@ where
     }
 }
 
-/// Particles per chunk of [`G2pOp::run_nodes`].
-const CHUNK: usize = 8;
+/// Particles per chunk of [`G2pOp::run_nodes`] (the lanes of [`update_lanes`]).
+const CHUNK: usize = update_lanes::LANES;
 
 /// The update of particle `i` from its grid sample (or the sample's error): the particle's
 /// checks, then the sample's status, then [`update_validated`] and the position limit.
@@ -239,7 +268,7 @@ unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, con
     ch: &[InChannel<T, D>; D],
     comps: (usize, usize),
 ) -> ([T; D], [[T; D]; D], [[T; D]; D], bool) {
-    let mut q = [[T::ZERO; N]; D];
+    let mut q = [NodeVals::<T, N>::new(); D];
     let mut chk = true;
     // Loops over all `d` components with a test (a fixed trip count the compiler unrolls).
     let on = |a: usize| comps.0 <= a && a < comps.1;
@@ -254,7 +283,7 @@ unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, con
     for i in 0..N {
         for a in 0..D {
             if on(a) {
-                sum[a] += R::splat(q[a][i]) * m[i];
+                sum[a] += R::splat(q[a].v[i]) * m[i];
             }
         }
     }
@@ -294,7 +323,7 @@ unsafe fn temperatures<
     new: &InChannel<T, D>,
     old: &InChannel<T, D>,
 ) -> (T, T, bool) {
-    let (mut tn, mut to) = ([T::ZERO; N], [T::ZERO; N]);
+    let (mut tn, mut to) = (NodeVals::<T, N>::new(), NodeVals::<T, N>::new());
     let mut chk = read::<T, R, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
     chk &= read::<T, R, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
     // Lane 0 of each row is the weight: lane 0 sums Σ w Tⁿ⁺¹, lane 1 Σ w (Tⁿ⁺¹ − Tⁿ).
@@ -306,8 +335,8 @@ unsafe fn temperatures<
     }
     let (mut pic, mut flip) = (T::ZERO, T::ZERO);
     for i in 0..N {
-        pic += w[i] * tn[i];
-        flip += w[i] * (tn[i] - to[i]);
+        pic += w[i] * tn.v[i];
+        flip += w[i] * (tn.v[i] - to.v[i]);
     }
     (pic, flip, chk)
 }

@@ -34,6 +34,7 @@ pub mod g2p;
 mod nodes;
 pub mod p2g;
 mod tile;
+mod update_lanes;
 
 pub use crate::kernel::batch::BatchStatus;
 

@@ -13,7 +13,7 @@
 //! added to the grid once per run.
 
 use super::nodes::{add, node_offsets, nodes, rel_base, restore, table, taint, with_nodes};
-use super::tile::{axis0, factors, grad_coef, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
+use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use super::{BatchStatus, Checked, FirstFailure, NodeBox, OutChannel, Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
@@ -343,14 +343,16 @@ where
         }
     }
 
-    /// The tile lane vectors of a particle's node values per active channel (see
-    /// [`super::tile`]), for lane offset `s0` along axis 0.
+    /// Sets the tile lane vectors of a particle's node values per active channel (see
+    /// [`super::tile`]), for lane offset `s0` along axis 0, into `out` (the other entries are
+    /// left as they are).
     #[inline(always)]
-    fn coef<R: Lane<Scalar = T>, const K: usize>(
+    fn set_coef<R: Lane<Scalar = T>, const K: usize>(
         &self,
         r: &Ready<T, D>,
         s0: usize,
-    ) -> [Coef<R, D>; MAX_CH] {
+        out: &mut [Coef<R, D>; MAX_CH],
+    ) {
         let sp = R::splat;
         let (w, dw) = axis0::<T, R, D, K>(&r.s, s0);
         // The axis-0 node offsets o₀ of the lanes (exact small integers).
@@ -360,48 +362,35 @@ where
         }
         let o0 = R::load(&lane);
         let idt = self.args.impulse_dt;
-        let only = |p: R| Coef {
-            p,
-            e: None,
-            b: None,
-        };
-        let mut out = [only(sp(T::ZERO)); MAX_CH];
         for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
-            *c = match kind {
-                0 => only(w * sp(r.mass)),
+            match kind {
+                0 => *c = Coef::only(w * sp(r.mass)),
                 k @ 1..=3 => {
                     // w (q₀ + (mCh) o) + Δt_f f.
                     let a = k - 1;
                     let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
-                    let mut e = [sp(T::ZERO); D];
-                    for (b, x) in e.iter_mut().enumerate().skip(1) {
-                        *x = w * sp(r.mch.cols[b][a]);
-                    }
                     if idt == T::ZERO {
-                        Coef {
-                            p: w * q,
-                            e: Some(e),
-                            b: None,
-                        }
+                        c.p = w * q;
+                        c.has_b = false;
                     } else {
-                        let f = grad_coef(w, dw, &r.fm, a, idt);
-                        Coef {
-                            p: w.mul_add(q, f.p),
-                            e: Some(e),
-                            b: f.b,
-                        }
+                        set_grad(c, w, dw, &r.fm, a, idt);
+                        c.p = w.mul_add(q, c.p);
                     }
+                    for b in 1..D {
+                        c.e[b] = w * sp(r.mch.cols[b][a]);
+                    }
+                    c.has_e = true;
                 }
-                k @ 4..=6 => grad_coef(w, dw, &r.fm, k - 4, T::ONE),
-                k => only(w * sp(r.heat[k - 7])),
-            };
+                k @ 4..=6 => set_grad(c, w, dw, &r.fm, k - 4, T::ONE),
+                k => *c = Coef::only(w * sp(r.heat[k - 7])),
+            }
         }
-        out
     }
 
     /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
     /// particle does not fit in its tile or the run is full.
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
@@ -410,6 +399,7 @@ where
         tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
+        coef: &mut [Coef<R, D>; MAX_CH],
     ) -> Result<()> {
         let rel = rel_base(&r.s, &self.view.nodes)?;
         if run.n == MAX_RUN {
@@ -422,8 +412,8 @@ where
             // An empty tile takes any stencil.
             self.flush::<R, K, N>(tile, run, oc);
         };
-        let coef = self.coef::<R, K>(r, s[0]);
-        tile.add::<K, N>(&s, &factors::<T, D, K, N>(&r.s), &coef, self.na);
+        self.set_coef::<R, K>(r, s[0], coef);
+        tile.add::<K, N>(&s, &factors::<T, D, K, N>(&r.s), &coef[..self.na]);
         run.idx[run.n] = i;
         run.tau[run.n] = tau_dev;
         run.n += 1;
@@ -464,10 +454,11 @@ where
         tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
+        coef: &mut [Coef<R, D>; MAX_CH],
     ) {
         let r = match self.ready(pre, tau_dev) {
             Err(e) => Err(e),
-            Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc),
+            Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc, coef),
         };
         self.first.note(i, r);
     }
@@ -503,6 +494,9 @@ where
         debug_assert_eq!(R::LANES, TILE_X);
         let oc = node_offsets::<T, D, K, N>();
         let mut tile = Tile::<R, D>::new();
+        // The tile lane vectors of the particle being added (filled per particle for the
+        // active channels; one buffer, so that no per-particle array is initialised).
+        let mut coef = [Coef::only(R::splat(T::ZERO)); MAX_CH];
         let mut run = Run {
             n: 0,
             idx: [0; MAX_RUN],
@@ -576,7 +570,15 @@ where
                     }
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
-                        self.finish::<R, K, N>(start + l, &pr, tau, &mut tile, &mut run, &oc)
+                        self.finish::<R, K, N>(
+                            start + l,
+                            &pr,
+                            tau,
+                            &mut tile,
+                            &mut run,
+                            &oc,
+                            &mut coef,
+                        )
                     };
                 }
             }

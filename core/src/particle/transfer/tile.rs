@@ -51,14 +51,40 @@ pub(super) const MAX_ROWS: usize = 25;
 pub(super) const MAX_RUN: usize = 16;
 /// Most channels written by one P2G call.
 pub(super) const MAX_CH: usize = 10;
+/// Largest dimension.
+const MAX_D: usize = 3;
+/// Most stencil rows `K^{d−1}` (the cubic kernel in 3D).
+const MAX_STENCIL_ROWS: usize = 16;
 
 /// The per-particle lane vectors of one channel's node values (see the module docs). A term
-/// that the channel does not have is skipped (`e`, `b` false).
+/// that the channel does not have is skipped (`has_e`, `has_b` false). Plain arrays and flags
+/// rather than `Option`s: an `Option` of vectors puts them at odd offsets behind its tag, and
+/// its copies then load across the smaller stores that wrote them, which the store buffer
+/// cannot forward.
 #[derive(Clone, Copy)]
 pub(super) struct Coef<R, const D: usize> {
     pub p: R,
-    pub e: Option<[R; D]>,
-    pub b: Option<[R; D]>,
+    /// `E_a` (`a ≥ 1`; entry 0 unused).
+    pub e: [R; D],
+    /// `B_a` (`a ≥ 1`; entry 0 unused).
+    pub b: [R; D],
+    pub has_e: bool,
+    pub has_b: bool,
+}
+
+impl<T: Real, R: Lane<Scalar = T>, const D: usize> Coef<R, D> {
+    /// A channel with the `P` term only.
+    #[inline(always)]
+    pub fn only(p: R) -> Self {
+        let z = R::splat(T::ZERO);
+        Self {
+            p,
+            e: [z; D],
+            b: [z; D],
+            has_e: false,
+            has_b: false,
+        }
+    }
 }
 
 /// A tile of summed node values per channel.
@@ -107,47 +133,74 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     }
 
     /// Adds the node values of one particle: stencil rows `r` (`N/K` of them, axis-0 nodes
-    /// `r·K..r·K + K`) with row factors `c[r]`, for the first `nc` channels of `coef`.
+    /// `r·K..r·K + K`) with row factors `c[r]`, for channels `0..coef.len()` with the lane
+    /// vectors `coef`.
     #[inline(always)]
     pub fn add<const K: usize, const N: usize>(
         &mut self,
         s: &[usize; D],
         c: &[[T; D]; N],
-        coef: &[Coef<R, D>; MAX_CH],
-        nc: usize,
+        coef: &[Coef<R, D>],
     ) {
         let lanes = ((1u32 << K) - 1) << s[0];
+        // Per stencil row: its tile row `t` and the factors `c₀`, `c₀ o_a`, `c_a` (a ≥ 1).
+        debug_assert!(N / K <= MAX_STENCIL_ROWS);
+        let mut rt = [0usize; MAX_STENCIL_ROWS];
+        let mut fc = [[T::ZERO; 2 * MAX_D]; MAX_STENCIL_ROWS];
         for (r, cr) in c.iter().enumerate().take(N / K) {
-            // Tile row and the row's offsets along axes 1.. (node r·K has o₀ = 0).
+            // Node r·K has o₀ = 0: the row's offsets along axes 1...
             let o = Offsets::<D, K, N>::O[r * K];
             let mut t = 0usize;
             let mut step = 1usize;
-            let mut c0o = [T::ZERO; D];
+            fc[r][0] = cr[0];
             for a in 1..D {
                 t += (s[a] + o[a]) * step;
                 step *= K + 1;
-                c0o[a] = cr[0] * T::from_i32(o[a] as i32);
+                fc[r][a] = cr[0] * T::from_i32(o[a] as i32);
+                fc[r][D + a] = cr[a];
             }
             self.bits[t] |= lanes;
-            let c0 = R::splat(cr[0]);
-            let (mut ca, mut co) = ([c0; D], [c0; D]);
-            for a in 1..D {
-                ca[a] = R::splat(cr[a]);
-                co[a] = R::splat(c0o[a]);
-            }
-            for (j, k) in coef.iter().enumerate().take(nc) {
-                let mut v = c0.mul_add(k.p, self.acc[j][t]);
-                if let Some(e) = &k.e {
-                    for a in 1..D {
-                        v = co[a].mul_add(e[a], v);
+            rt[r] = t;
+        }
+        // Channel by channel, so that its lane vectors and terms are chosen once.
+        for (j, k) in coef.iter().enumerate() {
+            let acc = &mut self.acc[j];
+            match (k.has_e, k.has_b) {
+                (false, false) => {
+                    for r in 0..N / K {
+                        acc[rt[r]] = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
                     }
                 }
-                if let Some(b) = &k.b {
-                    for a in 1..D {
-                        v = ca[a].mul_add(b[a], v);
+                (true, false) => {
+                    for r in 0..N / K {
+                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
+                        for a in 1..D {
+                            v = R::splat(fc[r][a]).mul_add(k.e[a], v);
+                        }
+                        acc[rt[r]] = v;
                     }
                 }
-                self.acc[j][t] = v;
+                (false, true) => {
+                    for r in 0..N / K {
+                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
+                        for a in 1..D {
+                            v = R::splat(fc[r][D + a]).mul_add(k.b[a], v);
+                        }
+                        acc[rt[r]] = v;
+                    }
+                }
+                (true, true) => {
+                    for r in 0..N / K {
+                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
+                        for a in 1..D {
+                            v = R::splat(fc[r][a]).mul_add(k.e[a], v);
+                        }
+                        for a in 1..D {
+                            v = R::splat(fc[r][D + a]).mul_add(k.b[a], v);
+                        }
+                        acc[rt[r]] = v;
+                    }
+                }
             }
         }
         self.used = true;
@@ -269,27 +322,25 @@ pub(super) fn axis0<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize
     (R::load(&wl), R::load(&dl))
 }
 
-/// The [`Coef`] of the node values `f Σ_b m_{ab} ∂w/∂x_b` (a force: row `a` of `f m` times
-/// the weight gradient), from the axis-0 lanes `w`, `dw` of [`axis0`]. Written with loops, not
-/// `array::from_fn`: a closure there is not inlined into the caller's target features, and
-/// its vector operations become calls.
+/// Sets `c` to the [`Coef`] of the node values `f Σ_b m_{ab} ∂w/∂x_b` (a force: row `a` of
+/// `f m` times the weight gradient), from the axis-0 lanes `w`, `dw` of [`axis0`]. Written with
+/// loops, not `array::from_fn`: a closure there is not inlined into the caller's target
+/// features, and its vector operations become calls.
 #[inline(always)]
-pub(super) fn grad_coef<T: Real, R: Lane<Scalar = T>, const D: usize>(
+pub(super) fn set_grad<T: Real, R: Lane<Scalar = T>, const D: usize>(
+    c: &mut Coef<R, D>,
     w: R,
     dw: R,
     m: &Mat<T, D>,
     a: usize,
     f: T,
-) -> Coef<R, D> {
-    let mut b = [R::splat(T::ZERO); D];
-    for (c, x) in b.iter_mut().enumerate().skip(1) {
-        *x = w * R::splat(f * m.cols[c][a]);
+) {
+    c.p = dw * R::splat(f * m.cols[0][a]);
+    for b in 1..D {
+        c.b[b] = w * R::splat(f * m.cols[b][a]);
     }
-    Coef {
-        p: dw * R::splat(f * m.cols[0][a]),
-        e: None,
-        b: Some(b),
-    }
+    c.has_e = false;
+    c.has_b = true;
 }
 
 /// The row factors ([`row_factors`]) of every stencil row (`N/K` rows; entries past them 0).
