@@ -827,6 +827,9 @@ where
             ps[20].f_e = Mat::identity();
             ps[20].f_e.cols[0][0] = -T::ONE;
             ps[37].phase = Phase::Liquid;
+            // Particle 50 apart from the others (which lie in [4h, 8h] per axis), so that only
+            // it reads the compressive nodes below.
+            ps[50].x[0] = T::from_f64(11.3 * hf);
             let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
             let mut r2 = Pcg64::seed_from_u64(12);
             for k in 0..g.ch[0].len() {
