@@ -709,6 +709,21 @@ fn fill<T: Real, const D: usize>(
     }
 }
 
+/// A grid over `[-1, cells + 1)` per axis with random node velocities in `[-1, 1)` m/s and
+/// new and old node temperatures within 5 K of `TM` (what G2P reads), from `seed`.
+fn g2p_grid<T: Real, const D: usize>(cells: i32, seed: u64) -> DenseGrid<T, D> {
+    let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
+    let mut r2 = Pcg64::seed_from_u64(seed);
+    for k in 0..g.ch[0].len() {
+        for a in 0..D {
+            g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
+        }
+        g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+        g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+    }
+    g
+}
+
 /// G2P equals the per-particle reference on a random grid (every material, both kernels).
 fn g2p_matches<T: BatchReal, const D: usize>()
 where
@@ -724,16 +739,7 @@ where
             for kernel in [Kernel::Quadratic, Kernel::Cubic] {
                 let mut rng = Pcg64::seed_from_u64(5);
                 let ps = particles::<T, D>(&mut rng, 60, hf, cells, &mat);
-                let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
-                let mut r2 = Pcg64::seed_from_u64(9);
-                let n = g.ch[0].len();
-                for k in 0..n {
-                    for a in 0..D {
-                        g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
-                    }
-                    g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-                    g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-                }
+                let g = g2p_grid::<T, D>(cells, 9);
                 let mut store = Store::from(&ps);
                 let args = G2pArgs { kernel, h, dt };
                 let raw = store.raw();
@@ -830,15 +836,7 @@ where
             // Particle 50 apart from the others (which lie in [4h, 8h] per axis), so that only
             // it reads the compressive nodes below.
             ps[50].x[0] = T::from_f64(11.3 * hf);
-            let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
-            let mut r2 = Pcg64::seed_from_u64(12);
-            for k in 0..g.ch[0].len() {
-                for a in 0..D {
-                    g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
-                }
-                g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-                g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
-            }
+            let mut g = g2p_grid::<T, D>(cells, 12);
             // Around particle 50: node velocities along axis 0 converging at 2000 m/s per
             // cell, so that ∂v₀/∂x₀ ≈ −2000/h and det(I + Δt∇v) ≈ 1 − 2000·Δt/h < 0.
             let s50 = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &ps[50].x).unwrap();
