@@ -811,11 +811,14 @@ where
 }
 
 /// G2P of a whole batch gives the bits of calls of one particle each, on every instruction set
-/// and material: the batch updates chunks of plain elastic particles on SIMD lanes, a call of
-/// one particle updates it alone (the scalar update). The batch mixes chunks that stay on
-/// lanes with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
-/// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node
-/// velocity), and a liquid particle among solids.
+/// and material, for solid and for liquid batches: the batch updates chunks of elastic solids
+/// and of liquids on SIMD lanes, a call of one particle updates it alone (the scalar update).
+/// The batch mixes chunks that stay on lanes with chunks that must fall back: a particle with a
+/// NaN `F_P`, one whose `F_E` is inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a
+/// strongly compressive node velocity), a particle of the other phase, and one whose `F_E` has
+/// a subnormal column (the liquid projection's scalings leave the normal range). Liquid batches
+/// also have isotropic and general `F_P` and an `F_E` with columns of very different scales
+/// (the projection's root on equilibrated columns), in chunks that stay on lanes.
 fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -826,13 +829,39 @@ where
     let h = T::from_f64(hf);
     let dt = T::from_f64(1e-3);
     for isa in Isa::available() {
-        for (name, mat) in materials::<T>() {
+        for ((name, mat), liquid) in materials::<T>()
+            .into_iter()
+            .flat_map(|m| [(m.clone(), false), (m, true)])
+        {
+            if liquid && mat.heat.is_some() {
+                // Heat is updated per particle: nothing on lanes to compare.
+                continue;
+            }
             let mut rng = Pcg64::seed_from_u64(11);
             let mut ps = particles::<T, D>(&mut rng, 75, hf, cells, &mat);
+            let (this, other) = if liquid {
+                (Phase::Liquid, Phase::Solid)
+            } else {
+                (Phase::Solid, Phase::Liquid)
+            };
+            for (i, p) in ps.iter_mut().enumerate() {
+                p.phase = this;
+                if liquid && i % 3 == 1 {
+                    p.f_p = Mat::identity() * T::from_f64(rng.random_range(0.8..1.25));
+                } else if liquid && i % 3 == 2 {
+                    p.f_p = deformation::<D>(&mut rng, 0.8, 1.25).cast();
+                }
+            }
             ps[9].f_p.cols[0][0] = T::from_f64(f64::NAN);
             ps[20].f_e = Mat::identity();
             ps[20].f_e.cols[0][0] = -T::ONE;
-            ps[37].phase = Phase::Liquid;
+            ps[37].phase = other;
+            // Columns 2^∓(bias/2) and 2^±(bias/3) apart from the others: exact scalings on lanes.
+            let (k0, k1) = (T::MAX_EXP / 2, T::MAX_EXP / 3);
+            ps[60].f_e.cols[0] = ps[60].f_e.cols[0].map(|x| x.scalbn(-k0));
+            ps[60].f_e.cols[1] = ps[60].f_e.cols[1].map(|x| x.scalbn(k1));
+            // A subnormal column: the scalar path decides.
+            ps[70].f_e.cols[0] = ps[70].f_e.cols[0].map(|x| x.scalbn(-T::MAX_EXP - 4));
             // Particle 50 apart from the others (which lie in [4h, 8h] per axis), so that only
             // it reads the compressive nodes below.
             ps[50].x[0] = T::from_f64(11.3 * hf);
@@ -885,9 +914,9 @@ where
             assert_eq!(
                 first.map(|f| f.0).unwrap_or(ps.len()),
                 st.first_failed,
-                "{name} {isa:?}"
+                "{name} {liquid} {isa:?}"
             );
-            assert_eq!(first.map(|f| f.1), st.error, "{name} {isa:?}");
+            assert_eq!(first.map(|f| f.1), st.error, "{name} {liquid} {isa:?}");
             assert!(first.is_some(), "{name}: the NaN particle fails");
             let bits = |s: &Store<T>| -> Vec<u64> {
                 [
@@ -904,7 +933,7 @@ where
                 .chain(s.phase.iter().map(|&c| u64::from(c)))
                 .collect()
             };
-            assert_eq!(bits(&batch), bits(&one), "{name} {isa:?}");
+            assert_eq!(bits(&batch), bits(&one), "{name} {liquid} {isa:?}");
         }
     }
 }

@@ -19,7 +19,7 @@ use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::{update_validated, G2pSample};
-use crate::particle::{Material, Phase};
+use crate::particle::Material;
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
 
@@ -155,9 +155,8 @@ where
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
-        // Chunks of plain elastic particles are updated on the row type's eight lanes.
-        let lanes = update_lanes::plain(self.material) && R::LANES == CHUNK;
-        let solid_ok = self.checked.for_phase(Phase::Solid).is_ok();
+        // Chunks of elastic solids or of liquids are updated on the row type's eight lanes.
+        let lanes = update_lanes::on_lanes(self.material) && R::LANES == CHUNK;
         let mut cs = ChunkSamples::new();
         let mut start = 0;
         while start < self.n {
@@ -182,14 +181,14 @@ where
                     _ => all_ok = false,
                 }
             }
-            // SAFETY: as above; `plain(material)` when `lanes`.
+            // SAFETY: as above; `on_lanes(material)` when `lanes`.
             if lanes
                 && len == CHUNK
                 && all_ok
                 && unsafe {
                     update_lanes::update::<T, R, D>(
                         self.material,
-                        solid_ok,
+                        &self.checked,
                         self.args.dt,
                         self.args.h,
                         self.ps,

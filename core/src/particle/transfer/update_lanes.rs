@@ -1,19 +1,25 @@
-//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane), for the
-//! plain elastic update: no heat, no plasticity, every particle of the chunk solid.
+//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane), for
+//! materials without heat, when every particle of the chunk is either a solid without
+//! plasticity (the plain elastic update) or a liquid.
 //!
-//! The update is that of [`crate::particle::update::update_particle`] for these materials
+//! The update is that of [`crate::particle::update::update_particle`] for these particles
 //! (Stomakhin et al. 2014, §5: APIC velocity and affine matrix, `x ← x + Δt v`,
-//! `F_E ← (I + Δt∇v) F_E`, `F_P` kept), with the same operations in the same order (separate
+//! `F_E ← (I + Δt∇v) F_E`; a solid keeps `F_P`, a liquid is projected to its volume ratios by
+//! [`liquid_projection`]), with the same operations in the same order (separate
 //! multiplications and additions, no fused multiply-add, the matrix products and determinants of
-//! [`crate::mat::Mat`]), so every lane gets the bits of the scalar update. Every check of the
-//! scalar path is made on all lanes (the input particle as [`check_particle`] checks it, the new
-//! position, `det(I + Δt∇v) > 0`, the new `F_E` and its determinant, the position limit); if any
-//! lane fails one, or needs the remedy for `det(I + Δt∇v) ≤ 0`, nothing is written and the
-//! caller updates the chunk's particles one by one, which gives each its exact status.
+//! [`crate::mat::Mat`], the power-of-two scalings and roots of [`root_det`]), so every lane gets
+//! the bits of the scalar update. Every check of the scalar path is made on all lanes (the
+//! input particle as [`check_particle`] checks it, the new position, `det(I + Δt∇v) > 0`, the
+//! new `F_E` and `F_P` and their determinants, the position limit); if any lane fails one, needs
+//! the remedy for `det(I + Δt∇v) ≤ 0`, or lies where [`root_det`]'s scalings leave the normal
+//! range, nothing is written and the caller updates the chunk's particles one by one, which
+//! gives each its exact status.
 //!
 //! [`check_particle`]: crate::particle::update::check_particle
+//! [`liquid_projection`]: crate::particle::deformation::liquid_projection
+//! [`root_det`]: crate::particle::deformation::root_det
 
-use super::Particles;
+use super::{Checked, Particles};
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
 use crate::particle::update::G2pSample;
@@ -60,10 +66,11 @@ impl<T: Real> ChunkSamples<T> {
     }
 }
 
-/// Whether a material's update is the plain elastic one that [`update`] runs.
+/// Whether [`update`] can run a material's chunks: no heat (a chunk must then also be all solid
+/// without plasticity, or all liquid; [`update`] checks that).
 #[inline(always)]
-pub(super) fn plain<T: Real>(material: &Material<T>) -> bool {
-    material.heat.is_none() && material.plasticity.is_none()
+pub(super) fn on_lanes<T: Real>(material: &Material<T>) -> bool {
+    material.heat.is_none()
 }
 
 /// A `D × D` matrix of lanes from particle matrices at `p` (`d²` scalars per particle,
@@ -127,35 +134,162 @@ fn product<V: Lane, const D: usize>(a: &LMat<V, D>, b: &LMat<V, D>) -> LMat<V, D
     m
 }
 
-/// Updates particles `start..start + LANES` from their transposed samples `cs` (each sample
-/// was computed without error) with step `dt` on a collocated grid of spacing `h`, if every
-/// lane passes every check of the scalar update (see the module docs); returns whether it did.
-/// Writes `x, v, affine, f_e` (`f_p` is kept and not written).
+/// The phase of every particle of the chunk at `start` (solid when `phase` is null), or `None`
+/// for a chunk of mixed (or invalid) phases.
 ///
 /// # Safety
-/// The arrays of `ps` hold the chunk's particles; `plain(material)`.
+/// `phase` is null or holds the chunk's particles.
+#[inline(always)]
+unsafe fn chunk_phase(phase: *const u8, start: usize) -> Option<Phase> {
+    if phase.is_null() {
+        return Some(Phase::Solid);
+    }
+    let ph = core::slice::from_raw_parts(phase.add(start), LANES);
+    [Phase::Solid, Phase::Liquid]
+        .into_iter()
+        .find(|&p| ph.iter().all(|&c| c == p as u8))
+}
+
+/// `(det M)^{1/d}` per lane with the bits of [`root_det`] (column equilibration by powers of
+/// two, `det M = det M̂ · 2ᵉ`, `e = d q + ρ`, root `(det M̂ · 2^ρ)^{1/d} · 2^q`), and the lanes
+/// where it is that root: finite `M` whose column maxima are normal and below `2^{bias−1}`
+/// (so every scaling is one multiplication by a normal power of two, as `scalbn` does it in that
+/// range), `det M̂ > 0`, and a finite positive root. The square root is correctly rounded on
+/// every path; the cube root is the scalar [`Real::cbrt`] of each lane.
+///
+/// [`root_det`]: crate::particle::deformation::root_det
+#[inline(always)]
+fn root_det<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> (V, V::Mask) {
+    let zero = V::splat(T::ZERO);
+    let e_max = V::splat(T::from_i32(T::MAX_EXP - 2));
+    let mut ok = lmat::all_finite(m);
+    let mut g = *m;
+    let mut e = zero;
+    for j in 0..D {
+        // As `det_equilibrated`: the column maximum from 0, its frexp exponent, `x · 2^{−e_j}`.
+        let mut c = zero;
+        for i in 0..D {
+            c = c.max(m[j][i].abs());
+        }
+        let ej = c.exponent();
+        let col_ok = V::splat(T::MIN_POSITIVE).le(c) & ej.le(e_max);
+        ok = ok & col_ok;
+        let ej = V::select(col_ok, ej, zero);
+        let p = V::pow2(-ej);
+        for x in g[j].iter_mut() {
+            *x = *x * p;
+        }
+        e = e + ej;
+    }
+    let det = lmat::det(&g);
+    ok = ok & zero.lt(det);
+    // `e.div_euclid(d)`: `e / d` is within half an ulp of `q + ρ/d`, never across an integer.
+    let d = V::splat(T::from_i32(D as i32));
+    let q = (e / d).floor();
+    let rho = e - d * q;
+    let y = det * V::pow2(rho);
+    let root = if D == 2 {
+        y.sqrt()
+    } else {
+        let mut a = [T::ZERO; LANES];
+        y.store(&mut a);
+        for x in a.iter_mut() {
+            *x = x.cbrt();
+        }
+        V::load(&a)
+    };
+    // |q| ≤ bias − 1 by the column bounds: one multiplication, as `scalbn`.
+    let r = root * V::pow2(q);
+    (r, ok & r.is_finite() & zero.lt(r))
+}
+
+/// `s I`.
+#[inline(always)]
+fn diagonal<V: Lane, const D: usize>(s: V) -> LMat<V, D> {
+    let mut m = lmat::zero::<V, D>();
+    for (j, c) in m.iter_mut().enumerate() {
+        c[j] = s;
+    }
+    m
+}
+
+/// Finite entries and a finite positive determinant ([`check_det`] accepts it).
+///
+/// [`check_det`]: crate::particle::deformation::check_det
+#[inline(always)]
+fn det_ok<V: Lane, const D: usize>(m: &LMat<V, D>) -> V::Mask {
+    let j = lmat::det(m);
+    lmat::all_finite(m) & j.is_finite() & V::splat(V::Scalar::ZERO).lt(j)
+}
+
+/// [`liquid_projection`] per lane: `(J_E^{1/d} I, F_P')` with `F_P' = F_P` where `F_P = s I`,
+/// `s > 0` exactly, else `J_P^{1/d} I` (`None`: `F_P` kept on every lane), and the lanes where
+/// both are the scalar results and pass [`check_det`] (`F_P`'s own determinant is checked by
+/// the caller).
+///
+/// [`liquid_projection`]: crate::particle::deformation::liquid_projection
+/// [`check_det`]: crate::particle::deformation::check_det
+#[inline(always)]
+fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
+    f_e: &LMat<V, D>,
+    f_p: &LMat<V, D>,
+) -> (LMat<V, D>, Option<LMat<V, D>>, V::Mask) {
+    let zero = V::splat(T::ZERO);
+    let (r_e, ok_e) = root_det(f_e);
+    let fe = diagonal::<V, D>(r_e);
+    let mut ok = ok_e & det_ok(&fe);
+    // As `isotropic_scale`: off-diagonal entries 0, diagonal entries equal to `f_p[0][0] > 0`.
+    let s = f_p[0][0];
+    let mut iso = zero.lt(s);
+    for (j, c) in f_p.iter().enumerate() {
+        for (i, x) in c.iter().enumerate() {
+            iso = iso & x.eq(if i == j { s } else { zero });
+        }
+    }
+    if V::all(iso) {
+        return (fe, None, ok);
+    }
+    let (r_p, ok_p) = root_det(f_p);
+    let mut fp = diagonal::<V, D>(r_p);
+    for (cn, c) in fp.iter_mut().zip(f_p.iter()) {
+        for (xn, x) in cn.iter_mut().zip(c.iter()) {
+            *xn = V::select(iso, *x, *xn);
+        }
+    }
+    ok = ok & (iso | (ok_p & det_ok(&fp)));
+    (fe, Some(fp), ok)
+}
+
+/// Updates particles `start..start + LANES` from their transposed samples `cs` (each sample
+/// was computed without error) with step `dt` on a collocated grid of spacing `h`, if the chunk
+/// is all solid (material without plasticity) or all liquid and every lane passes every check
+/// of the scalar update (see the module docs); returns whether it did. Writes
+/// `x, v, affine, f_e`, and `f_p` where a liquid's changes.
+///
+/// # Safety
+/// The arrays of `ps` hold the chunk's particles; `on_lanes(material)`.
 #[inline(always)]
 pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     material: &Material<T>,
-    solid_ok: bool,
+    checked: &Checked,
     dt: T,
     h: T,
     ps: &Particles<T>,
     start: usize,
     cs: &ChunkSamples<T>,
 ) -> bool {
-    debug_assert!(V::LANES == LANES && plain(material) && D <= MAX_D);
+    debug_assert!(V::LANES == LANES && on_lanes(material) && D <= MAX_D);
     let inv_h = T::ONE / h;
-    if !(solid_ok && dt.is_finite() && dt > T::ZERO && h.is_finite() && h > T::ZERO)
-        || !inv_h.is_finite()
-    {
+    if !(dt.is_finite() && dt > T::ZERO && h.is_finite() && h > T::ZERO) || !inv_h.is_finite() {
         return false;
     }
-    if !ps.phase.is_null() {
-        let ph = core::slice::from_raw_parts(ps.phase.add(start), LANES);
-        if ph.iter().any(|&c| c != Phase::Solid as u8) {
-            return false;
-        }
+    let phase = match chunk_phase(ps.phase, start) {
+        Some(Phase::Solid) if material.plasticity.is_none() => Phase::Solid,
+        Some(Phase::Liquid) => Phase::Liquid,
+        _ => return false,
+    };
+    if checked.for_phase(phase).is_err() {
+        return false;
     }
     // The input particles, as `check_particle` checks them: v and the affine matrix are only
     // checked (they are replaced), and checked where they lie.
@@ -215,6 +349,14 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     let f = product(&inc, &f_e);
     let j_new = lmat::det(&f);
     ok = ok & lmat::all_finite(&f) & j_new.is_finite() & zero.lt(j_new);
+    // A liquid keeps its volume ratios only; a solid (no plasticity) keeps `F_P`.
+    let (f, f_p_new) = if phase == Phase::Liquid {
+        let (fe, fp, proj_ok) = liquid(&f, &f_p);
+        ok = ok & proj_ok;
+        (fe, fp)
+    } else {
+        (f, None)
+    };
     if !V::all(ok) {
         return false;
     }
@@ -229,6 +371,9 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             let c = i + D * j;
             V::load(&cs.affine[c]).scatter(ps.affine.add(D * D * start + c), D * D, all);
             f[j][i].scatter(ps.f_e.add(D * D * start + c), D * D, all);
+            if let Some(fp) = &f_p_new {
+                fp[j][i].scatter(ps.f_p.add(D * D * start + c), D * D, all);
+            }
         }
     }
     true
