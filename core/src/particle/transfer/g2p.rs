@@ -104,9 +104,10 @@ where
         view,
         faces,
     };
-    // This loop has no particle lanes: its node sums run on eight-lane rows, which AVX2 has,
-    // and its AVX-512 build measured 20–30 % slower than its AVX2 build on an AVX-512 Xeon
-    // (the per-particle scalar work compiles worse there), with the same bits.
+    // This loop's lanes are eight wide (node sums on eight-lane rows, the particle update on
+    // chunks of eight), which AVX2 has; its AVX-512 build measured 20–30 % slower than its AVX2
+    // build on an AVX-512 Xeon (the per-particle scalar work compiles worse there), with the same
+    // bits. (Measured before the update moved onto lanes.)
     dispatch::<T, _>(isa.at_most_avx2(), &mut op)
 }
 
