@@ -213,9 +213,11 @@ fn diagonal<V: Lane, const D: usize>(s: V) -> LMat<V, D> {
     m
 }
 
-/// Finite entries and a finite positive determinant ([`check_det`] accepts it).
+/// Finite entries and a finite positive determinant ([`check_det`] and [`check_particle`]
+/// accept it).
 ///
 /// [`check_det`]: crate::particle::deformation::check_det
+/// [`check_particle`]: crate::particle::update::check_particle
 #[inline(always)]
 fn det_ok<V: Lane, const D: usize>(m: &LMat<V, D>) -> V::Mask {
     let j = lmat::det(m);
@@ -307,13 +309,12 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     let f_p = gather_mat::<T, V, D>(ps.f_p, start);
     let mass = V::load(core::slice::from_raw_parts(ps.mass.add(start), LANES));
     let vol = V::load(core::slice::from_raw_parts(ps.volume0.add(start), LANES));
-    let mut ok = lmat::all_finite(&f_e) & lmat::all_finite(&f_p);
+    // `F_E`, `F_P` finite with finite positive determinants, as `check_particle` requires.
+    let mut ok = det_ok(&f_e) & det_ok(&f_p);
     ok = ok & mass.is_finite() & vol.is_finite() & zero.lt(mass) & zero.lt(vol);
     for xa in &x {
         ok = ok & xa.is_finite();
     }
-    let (j_e, j_p) = (lmat::det(&f_e), lmat::det(&f_p));
-    ok = ok & j_e.is_finite() & j_p.is_finite() & zero.lt(j_e) & zero.lt(j_p);
 
     // The sample (finite: the sample stage checked it).
     let dtv = V::splat(dt);
@@ -347,8 +348,7 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     ok = ok & zero.lt(lmat::det(&inc));
     // F_E ← A F_E, finite with a finite positive determinant (`check_det`).
     let f = product(&inc, &f_e);
-    let j_new = lmat::det(&f);
-    ok = ok & lmat::all_finite(&f) & j_new.is_finite() & zero.lt(j_new);
+    ok = ok & det_ok(&f);
     // A liquid keeps its volume ratios only; a solid (no plasticity) keeps `F_P`.
     let (f, f_p_new) = if phase == Phase::Liquid {
         let (fe, fp, proj_ok) = liquid(&f, &f_p);
