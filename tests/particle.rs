@@ -1,5 +1,5 @@
 //! Tests of the MPM particle updates (`ampm_core::particle`), generated for every scalar ×
-//! dimension by one macro (the batch transfers and their C ABI are in tests/transfer.rs).
+//! dimension by one macro (the batch transfers and their C ABI are in tests/transfer/).
 //!
 //! Tolerances are in units of the scalar's ε and are derived where they are stated: a sum of
 //! `n` products of `k` rounded factors, each factor `O(1)`, has an error of at most about

@@ -1,0 +1,306 @@
+//! The force differential: reference stiffness, PSD option, unprepared slots, overflowing runs.
+use crate::{materials, particles, runs_of_particles, DenseGrid, Store, FORCE, MOM};
+use ampm_core::kernel::batch::BatchReal;
+use ampm_core::kernel::{Dim, LaneDim};
+use ampm_core::lane::Isa;
+use ampm_core::particle::implicit::slot_len;
+use ampm_core::particle::transfer::force::{self, ForceView};
+use ampm_core::particle::update::{elastic_energy, Stiffness};
+use ampm_core::particle::{Definiteness, Grid, Kernel, Material, Particle, Stencil};
+use ampm_core::polar::{DefaultSvd, SvdMethod};
+use ampm_core::{hessian::HessianDim, Error, Mat, Matrix};
+use ampm_tools::workload::HaarRotation;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// `δu ↦ δf` of one particle as a dense `(K^d·d)²` matrix, through prepare and apply.
+fn stiffness_matrix<T: BatchReal, const D: usize>(
+    isa: Isa,
+    mat: &Material<T>,
+    kernel: Kernel,
+    h: T,
+    p: &Particle<T, D>,
+) -> (Vec<f64>, usize, Vec<usize>)
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    let ps = [*p];
+    let mut store = Store::from(&ps);
+    let mut slot = vec![T::ZERO; slot_len(D)];
+    let raw = store.raw();
+    // SAFETY: one particle, one slot.
+    let st = unsafe { force::prepare::<T, D>(isa, mat, 1, &raw, slot.as_mut_ptr()) };
+    assert_eq!(st.error, None);
+    let s = Stencil::new(kernel, Grid::Collocated, h, &p.x).unwrap();
+    let lo = s.base;
+    let dims = [kernel.width() as i32; D];
+    let nodes: Vec<usize> = (0..s.len()).collect();
+    let m = s.len() * D;
+    let mut k = vec![0.0; m * m];
+    for col in 0..m {
+        let mut du = DenseGrid::<T, D>::new(lo, dims);
+        du.ch[MOM + col % D][col / D] = T::ONE;
+        let mut df = DenseGrid::<T, D>::new(lo, dims);
+        let view = ForceView {
+            nodes: du.nodes(),
+            du: std::array::from_fn(|a| du.inp(MOM + a)),
+            df: std::array::from_fn(|a| df.out(FORCE + a)),
+        };
+        // SAFETY: the channels cover the stencil.
+        let st = unsafe {
+            force::apply::<T, D>(isa, kernel, h, 1, store.x.as_ptr(), slot.as_ptr(), &view)
+        };
+        assert_eq!(st.error, None);
+        for row in 0..m {
+            k[row * m + col] = df.ch[FORCE + row % D][row / D].to_f64();
+        }
+    }
+    (k, m, nodes)
+}
+
+fn force_differential<T: BatchReal, const D: usize>()
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]> + HessianDim,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let h = T::from_f64(hf);
+    let eps = T::EPSILON.to_f64();
+    for (name, base) in materials::<T>() {
+        for isa in Isa::available() {
+            let mut rng = Pcg64::seed_from_u64(13);
+            let ps = particles::<T, D>(&mut rng, 6, hf, cells, &base);
+            for p in &ps {
+                // Exact: equals the reference Stiffness on every unit δu.
+                let exact = Material {
+                    hessian: Definiteness::Exact,
+                    ..base
+                };
+                let (k, m, _) = stiffness_matrix(isa, &exact, Kernel::Quadratic, h, p);
+                let e = elastic_energy(&exact, p).unwrap();
+                let st = Stiffness::new(&e, &exact, p).unwrap();
+                let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &p.x).unwrap();
+                let kmax = k.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                for col in 0..m {
+                    let mut g = Mat::<T, D>::ZERO;
+                    let gr = s.node(col / D).grad;
+                    for b in 0..D {
+                        g.cols[b][col % D] = gr[b];
+                    }
+                    let mm = st.d_force_matrix(&g).unwrap();
+                    for row in 0..m {
+                        let want = mm.mul_vec(s.node(row / D).grad)[row % D].to_f64();
+                        let got = k[row * m + col];
+                        assert!(
+                            (got - want).abs() <= 1024.0 * eps * kmax,
+                            "{name} {isa:?}: K[{row}][{col}] {got} vs {want} (max {kmax})"
+                        );
+                    }
+                }
+                // Symmetric (up to rounding).
+                for r in 0..m {
+                    for c in 0..r {
+                        let (a, b) = (k[r * m + c], k[c * m + r]);
+                        assert!((a - b).abs() <= 1024.0 * eps * kmax, "{name}: symmetry");
+                    }
+                }
+                // PSD option: ⟨δu, K δu⟩ ≤ 0 (K negative semi-definite) for random δu.
+                let psd = Material {
+                    hessian: Definiteness::Projected,
+                    ..base
+                };
+                let (kp, _, _) = stiffness_matrix(isa, &psd, Kernel::Quadratic, h, p);
+                let mut r2 = Pcg64::seed_from_u64(4);
+                let kpmax = kp.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+                for _ in 0..200 {
+                    let u: Vec<f64> = (0..m).map(|_| r2.random_range(-1.0..1.0)).collect();
+                    let mut q = 0.0;
+                    let mut uu = 0.0;
+                    for r in 0..m {
+                        uu += u[r] * u[r];
+                        for c in 0..m {
+                            q += u[r] * kp[r * m + c] * u[c];
+                        }
+                    }
+                    assert!(
+                        q <= 2048.0 * eps * kpmax * uu,
+                        "{name} {isa:?}: PSD option gives uᵀKu = {q} > 0"
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn force_differential_2d_f64() {
+    force_differential::<f64, 2>();
+}
+#[test]
+fn force_differential_3d_f64() {
+    force_differential::<f64, 3>();
+}
+#[test]
+fn force_differential_3d_f32() {
+    force_differential::<f32, 3>();
+}
+
+/// A stretched block with explicit dilation, J ≈ 1.3: the exact differential is indefinite
+/// (`β = −λJ(J − 1) < 0` on the skew pair modes), the projected one is not.
+#[test]
+fn psd_option_covers_the_dilational_part() {
+    type T = f64;
+    const D: usize = 3;
+    let mat = Material {
+        hessian: Definiteness::Projected,
+        ..Material::<T>::elastic(10.0, 1.0e4)
+    };
+    let mut p = Particle::<T, D>::at_rest([0.3; D], 1.0, 1.0e-3);
+    p.f_e = Mat::from_diagonal([1.1, 1.09, 1.08]);
+    let exact = Material {
+        hessian: Definiteness::Exact,
+        ..mat
+    };
+    let h = 0.05;
+    let isa = Isa::SCALAR;
+    let (k, m, _) = stiffness_matrix(isa, &exact, Kernel::Quadratic, h, &p);
+    let (kp, _, _) = stiffness_matrix(isa, &mat, Kernel::Quadratic, h, &p);
+    // Find a direction with uᵀKu > 0 for the exact K (a skew mode: rotate the stencil).
+    let max_q = |kk: &[f64]| {
+        let mut best = f64::MIN;
+        let mut rng = Pcg64::seed_from_u64(8);
+        for _ in 0..2000 {
+            let u: Vec<f64> = (0..m).map(|_| rng.random_range(-1.0..1.0)).collect();
+            let mut q = 0.0;
+            let mut uu = 0.0;
+            for r in 0..m {
+                uu += u[r] * u[r];
+                for c in 0..m {
+                    q += u[r] * kk[r * m + c] * u[c];
+                }
+            }
+            best = best.max(q / uu);
+        }
+        best
+    };
+    let kmax = k.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    assert!(
+        max_q(&k) > 1e-6 * kmax,
+        "the exact differential is indefinite here"
+    );
+    assert!(max_q(&kp) <= 1e-12 * kmax, "the projected one is not");
+}
+
+/// Zero-filled slots and the slots of failed prepares are refused (NotPrepared); nothing is
+/// written for them.
+#[test]
+fn unprepared_slots_are_refused() {
+    type T = f32;
+    const D: usize = 3;
+    let mat = Material::<T>::elastic(10.0, 100.0);
+    let mut ps = vec![Particle::<T, D>::at_rest([0.3; D], 1.0, 1.0e-3); 3];
+    ps[1].f_e.cols[0][0] = -1.0;
+    let mut store = Store::from(&ps);
+    let mut slots = vec![0.0 as T; 3 * slot_len(D)];
+    let raw = store.raw();
+    for isa in Isa::available() {
+        // SAFETY: three particles, three slots.
+        let st = unsafe { force::prepare::<T, D>(isa, &mat, 3, &raw, slots.as_mut_ptr()) };
+        assert_eq!((st.first_failed, st.error), (1, Some(Error::NonPositiveJ)));
+        let mut du = DenseGrid::<T, D>::new([0; D], [12; D]);
+        du.ch[MOM].iter_mut().for_each(|x| *x = 1.0e-3);
+        let mut df = DenseGrid::<T, D>::new([0; D], [12; D]);
+        let view = ForceView {
+            nodes: du.nodes(),
+            du: std::array::from_fn(|a| du.inp(MOM + a)),
+            df: std::array::from_fn(|a| df.out(FORCE + a)),
+        };
+        let zero = vec![0.0 as T; slot_len(D)];
+        // SAFETY: one slot.
+        let st = unsafe {
+            force::apply::<T, D>(
+                isa,
+                Kernel::Quadratic,
+                0.05,
+                1,
+                store.x.as_ptr(),
+                zero.as_ptr(),
+                &view,
+            )
+        };
+        assert_eq!(st.error, Some(Error::NotPrepared));
+        // SAFETY: three slots.
+        let st = unsafe {
+            force::apply::<T, D>(
+                isa,
+                Kernel::Quadratic,
+                0.05,
+                3,
+                store.x.as_ptr(),
+                slots.as_ptr(),
+                &view,
+            )
+        };
+        assert_eq!((st.first_failed, st.error), (1, Some(Error::NotPrepared)));
+    }
+}
+
+/// As [`crate::p2g::p2g_run_that_overflows_is_added_one_by_one`], for the force
+/// differential's apply.
+#[test]
+fn apply_run_that_overflows_is_added_one_by_one() {
+    type T = f64;
+    const D: usize = 3;
+    let h = 0.05;
+    let mat = Material::<T>::elastic(10.0, 100.0);
+    let ps = runs_of_particles::<T, D>(h);
+    let mut store = Store::from(&ps);
+    let mut slots = vec![0.0 as T; 6 * slot_len(D)];
+    for isa in Isa::available() {
+        // SAFETY: six particles, six slots.
+        let st = unsafe { force::prepare::<T, D>(isa, &mat, 6, &store.raw(), slots.as_mut_ptr()) };
+        assert_eq!(st.error, None);
+        let mut du = DenseGrid::<T, D>::new([0; D], [16; D]);
+        for (k, x) in du.ch[MOM].iter_mut().enumerate() {
+            *x = 1.0e-3 * (k % 7) as T;
+        }
+        let mut df = DenseGrid::<T, D>::new([0; D], [16; D]);
+        let poisoned = df.index([6; D]);
+        df.ch[FORCE + 1][poisoned] = T::NAN;
+        let mut only2 = df.clone();
+        let apply = |df: &mut DenseGrid<T, D>, first: usize, n: usize| {
+            let view = ForceView {
+                nodes: du.nodes(),
+                du: std::array::from_fn(|a| du.inp(MOM + a)),
+                df: std::array::from_fn(|a| df.out(FORCE + a)),
+            };
+            // SAFETY: particles first..first + n, their slots; the channels cover the box.
+            unsafe {
+                force::apply::<T, D>(
+                    isa,
+                    Kernel::Quadratic,
+                    h,
+                    n,
+                    store.x.as_ptr().add(first * D),
+                    slots.as_ptr().add(first * slot_len(D)),
+                    &view,
+                )
+            }
+        };
+        let st = apply(&mut df, 0, 6);
+        assert_eq!(
+            (st.first_failed, st.error),
+            (0, Some(Error::Overflow)),
+            "{isa:?}"
+        );
+        assert_eq!(apply(&mut only2, 2, 1).error, None);
+        assert_eq!(
+            df.bits(),
+            only2.bits(),
+            "{isa:?}: only particle 2 was written"
+        );
+    }
+}

@@ -1,0 +1,431 @@
+//! G2P: reference match, batch chunks against single particles, linear fields, nodes read.
+use crate::{deformation, materials, particles, rand_mat, DenseGrid, Store, HC, LATENT, MOM, TM};
+use ampm_core::kernel::batch::BatchReal;
+use ampm_core::lane::Isa;
+use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
+use ampm_core::particle::transfer::Particles;
+use ampm_core::particle::{g2p_update, Grid, GridSample, Kernel, Phase, Stencil};
+use ampm_core::polar::{DefaultSvd, SvdMethod};
+use ampm_core::{Error, Mat, Matrix, Real};
+use ampm_tools::workload::HaarRotation;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
+
+/// Fills channels `MOM..MOM+d` with a velocity field `v(x)` at the nodes of `grid`, and the
+/// temperature channels with `t(x)`, `t_old(x)`.
+fn fill<T: Real, const D: usize>(
+    g: &mut DenseGrid<T, D>,
+    grid: Grid,
+    h: f64,
+    v: impl Fn([f64; D]) -> [f64; D],
+    t: impl Fn([f64; D]) -> (f64, f64),
+) {
+    let n = g.ch[0].len();
+    for k in 0..n {
+        let mut idx = [0i32; D];
+        let mut q = k;
+        for a in 0..D {
+            idx[a] = g.lo[a] + (q % g.dims[a] as usize) as i32;
+            q /= g.dims[a] as usize;
+        }
+        let x: [f64; D] = std::array::from_fn(|a| {
+            let shift = match grid {
+                Grid::Face(f) if f != a => 0.5,
+                _ => 0.0,
+            };
+            (idx[a] as f64 + shift) * h
+        });
+        let vv = v(x);
+        for a in 0..D {
+            g.ch[MOM + a][k] = T::from_f64(vv[a]);
+        }
+        let (tn, to) = t(x);
+        g.ch[HC][k] = T::from_f64(tn);
+        g.ch[HC + 1][k] = T::from_f64(to);
+    }
+}
+
+/// A grid over `[-1, cells + 1)` per axis with random node velocities in `[-1, 1)` m/s and
+/// new and old node temperatures within 5 K of `TM` (what G2P reads), from `seed`.
+fn g2p_grid<T: Real, const D: usize>(cells: i32, seed: u64) -> DenseGrid<T, D> {
+    let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
+    let mut r2 = Pcg64::seed_from_u64(seed);
+    for k in 0..g.ch[0].len() {
+        for a in 0..D {
+            g.ch[MOM + a][k] = T::from_f64(r2.random_range(-1.0..1.0));
+        }
+        g.ch[HC][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+        g.ch[HC + 1][k] = T::from_f64(TM + r2.random_range(-5.0..5.0));
+    }
+    g
+}
+
+/// G2P equals the per-particle reference on a random grid (every material, both kernels).
+fn g2p_matches<T: BatchReal, const D: usize>()
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let h = T::from_f64(hf);
+    let dt = T::from_f64(1e-3);
+    for isa in Isa::available() {
+        for (name, mat) in materials::<T>() {
+            for kernel in [Kernel::Quadratic, Kernel::Cubic] {
+                let mut rng = Pcg64::seed_from_u64(5);
+                let ps = particles::<T, D>(&mut rng, 60, hf, cells, &mat);
+                let g = g2p_grid::<T, D>(cells, 9);
+                let mut store = Store::from(&ps);
+                let args = G2pArgs { kernel, h, dt };
+                let raw = store.raw();
+                // SAFETY: the arrays hold the particles; the grid covers their stencils.
+                let st = unsafe {
+                    g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None)
+                };
+                for (i, p) in ps.iter().enumerate() {
+                    let s = Stencil::new(kernel, Grid::Collocated, h, &p.x).unwrap();
+                    let vel: Vec<[T; D]> = s
+                        .nodes()
+                        .map(|nd| std::array::from_fn(|a| g.ch[MOM + a][g.index(nd.index)]))
+                        .collect();
+                    let tn: Vec<T> = s.nodes().map(|nd| g.ch[HC][g.index(nd.index)]).collect();
+                    let to: Vec<T> = s
+                        .nodes()
+                        .map(|nd| g.ch[HC + 1][g.index(nd.index)])
+                        .collect();
+                    let sample = GridSample {
+                        velocity: &vel,
+                        temperature: Some((&tn, &to)),
+                    };
+                    let want = g2p_update(&mat, kernel, h, dt, &sample, p);
+                    let got = store.get::<D>(i);
+                    match want {
+                        Err(e) => {
+                            assert_eq!(got, *p, "{name}: a failed particle keeps its state");
+                            assert!(st.error.is_some(), "{name} particle {i}: {e:?}");
+                        }
+                        Ok((w, _)) => {
+                            // The affine matrix is formed as (Σ w v oᵀ − v fxᵀ)/(κh) instead of
+                            // Σ w v (x_i − x_p)ᵀ/(κh²): a few roundings of its terms' scale
+                            // (|v|·K/(κh)); everything else is formed in the same order.
+                            let eps = T::EPSILON.to_f64();
+                            let vmax = 1.0;
+                            let kk = kernel.width() as f64;
+                            let ascale = vmax * kk / (kernel.apic_moment::<f64>() * hf);
+                            for j in 0..D {
+                                for r in 0..D {
+                                    let (a, b) = (got.affine.cols[j][r], w.affine.cols[j][r]);
+                                    assert!(
+                                        (a - b).to_f64().abs() <= 32.0 * eps * ascale,
+                                        "{name} {kernel:?} C[{r}][{j}]: {a:?} vs {b:?}"
+                                    );
+                                }
+                            }
+                            let close = |a: T, b: T, scale: f64| {
+                                (a - b).to_f64().abs() <= 64.0 * eps * scale.max(b.to_f64().abs())
+                            };
+                            for a in 0..D {
+                                assert!(close(got.x[a], w.x[a], 1.0), "{name} x");
+                                assert!(close(got.v[a], w.v[a], vmax), "{name} v");
+                            }
+                            for j in 0..D {
+                                for r in 0..D {
+                                    assert!(close(got.f_e.cols[j][r], w.f_e.cols[j][r], 2.0));
+                                    assert!(close(got.f_p.cols[j][r], w.f_p.cols[j][r], 2.0));
+                                }
+                            }
+                            assert!(close(got.temperature, w.temperature, TM), "{name} T");
+                            assert!(close(got.latent, w.latent, LATENT), "{name} U");
+                            assert_eq!(got.phase, w.phase, "{name} phase");
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// G2P of a whole batch gives the bits of calls of one particle each, on every instruction set
+/// and material, for solid and for liquid batches: the batch updates chunks of elastic solids
+/// and of liquids on SIMD lanes, a call of one particle updates it alone (the scalar update).
+/// The batch mixes chunks that stay on lanes with chunks that must fall back: a particle with a
+/// NaN `F_P`, one whose `F_E` is inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a
+/// strongly compressive node velocity), a particle of the other phase, and one whose `F_E` has
+/// a subnormal column (the liquid projection's scalings leave the normal range). Liquid batches
+/// also have isotropic and general `F_P` and an `F_E` with columns of very different scales
+/// (the projection's root on equilibrated columns), in chunks that stay on lanes.
+fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let h = T::from_f64(hf);
+    let dt = T::from_f64(1e-3);
+    for isa in Isa::available() {
+        for ((name, mat), liquid) in materials::<T>()
+            .into_iter()
+            .flat_map(|m| [(m.clone(), false), (m, true)])
+        {
+            if liquid && mat.heat.is_some() {
+                // Heat is updated per particle: nothing on lanes to compare.
+                continue;
+            }
+            let mut rng = Pcg64::seed_from_u64(11);
+            let mut ps = particles::<T, D>(&mut rng, 75, hf, cells, &mat);
+            let (this, other) = if liquid {
+                (Phase::Liquid, Phase::Solid)
+            } else {
+                (Phase::Solid, Phase::Liquid)
+            };
+            for (i, p) in ps.iter_mut().enumerate() {
+                p.phase = this;
+                if liquid && i % 3 == 1 {
+                    p.f_p = Mat::identity() * T::from_f64(rng.random_range(0.8..1.25));
+                } else if liquid && i % 3 == 2 {
+                    p.f_p = deformation::<D>(&mut rng, 0.8, 1.25).cast();
+                }
+            }
+            ps[9].f_p.cols[0][0] = T::from_f64(f64::NAN);
+            ps[20].f_e = Mat::identity();
+            ps[20].f_e.cols[0][0] = -T::ONE;
+            ps[37].phase = other;
+            // Columns 2^∓(bias/2) and 2^±(bias/3) apart from the others: exact scalings on lanes.
+            let (k0, k1) = (T::MAX_EXP / 2, T::MAX_EXP / 3);
+            ps[60].f_e.cols[0] = ps[60].f_e.cols[0].map(|x| x.scalbn(-k0));
+            ps[60].f_e.cols[1] = ps[60].f_e.cols[1].map(|x| x.scalbn(k1));
+            // A subnormal column: the scalar path decides.
+            ps[70].f_e.cols[0] = ps[70].f_e.cols[0].map(|x| x.scalbn(-T::MAX_EXP - 4));
+            // Particle 50 apart from the others (which lie in [4h, 8h] per axis), so that only
+            // it reads the compressive nodes below.
+            ps[50].x[0] = T::from_f64(11.3 * hf);
+            let mut g = g2p_grid::<T, D>(cells, 12);
+            // Around particle 50: node velocities along axis 0 converging at 2000 m/s per
+            // cell, so that ∂v₀/∂x₀ ≈ −2000/h and det(I + Δt∇v) ≈ 1 − 2000·Δt/h < 0.
+            let s50 = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &ps[50].x).unwrap();
+            for nd in s50.nodes() {
+                let k = g.index(nd.index);
+                let o = nd.index[0] - s50.base[0] - 1;
+                g.ch[MOM][k] = T::from_f64(-2000.0 * f64::from(o));
+                for a in 1..D {
+                    g.ch[MOM + a][k] = T::ZERO;
+                }
+            }
+            let args = G2pArgs {
+                kernel: Kernel::Quadratic,
+                h,
+                dt,
+            };
+            let mut batch = Store::from(&ps);
+            let raw = batch.raw();
+            // SAFETY: the arrays hold the particles; the grid covers their stencils.
+            let st =
+                unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
+            let mut one = Store::from(&ps);
+            let mut first = None;
+            for i in 0..ps.len() {
+                let r = one.raw();
+                // SAFETY: particle `i` of the arrays, as one particle.
+                let st1 = unsafe {
+                    let at = Particles {
+                        x: r.x.add(D * i),
+                        v: r.v.add(D * i),
+                        affine: r.affine.add(D * D * i),
+                        f_e: r.f_e.add(D * D * i),
+                        f_p: r.f_p.add(D * D * i),
+                        mass: r.mass.add(i),
+                        volume0: r.volume0.add(i),
+                        temperature: r.temperature.add(i),
+                        latent: r.latent.add(i),
+                        phase: r.phase.add(i),
+                    };
+                    g2p::g2p_update(isa, &mat, &args, 1, &at, &g.g2p_view(), None)
+                };
+                if let (None, Some(e)) = (first, st1.error) {
+                    first = Some((i, e));
+                }
+            }
+            assert_eq!(
+                first.map(|f| f.0).unwrap_or(ps.len()),
+                st.first_failed,
+                "{name} {liquid} {isa:?}"
+            );
+            assert_eq!(first.map(|f| f.1), st.error, "{name} {liquid} {isa:?}");
+            assert!(first.is_some(), "{name}: the NaN particle fails");
+            let bits = |s: &Store<T>| -> Vec<u64> {
+                [
+                    &s.x,
+                    &s.v,
+                    &s.affine,
+                    &s.f_e,
+                    &s.f_p,
+                    &s.temperature,
+                    &s.latent,
+                ]
+                .iter()
+                .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
+                .chain(s.phase.iter().map(|&c| u64::from(c)))
+                .collect()
+            };
+            assert_eq!(bits(&batch), bits(&one), "{name} {liquid} {isa:?}");
+        }
+    }
+}
+
+#[test]
+fn g2p_chunks_match_single_2d_f32() {
+    g2p_chunks_match_single::<f32, 2>();
+}
+#[test]
+fn g2p_chunks_match_single_3d_f32() {
+    g2p_chunks_match_single::<f32, 3>();
+}
+#[test]
+fn g2p_chunks_match_single_3d_f64() {
+    g2p_chunks_match_single::<f64, 3>();
+}
+
+#[test]
+fn g2p_matches_reference_2d_f32() {
+    g2p_matches::<f32, 2>();
+}
+#[test]
+fn g2p_matches_reference_2d_f64() {
+    g2p_matches::<f64, 2>();
+}
+#[test]
+fn g2p_matches_reference_3d_f32() {
+    g2p_matches::<f32, 3>();
+}
+#[test]
+fn g2p_matches_reference_3d_f64() {
+    g2p_matches::<f64, 3>();
+}
+
+/// On `v(x) = v₀ + A x` (collocated or MAC), G2P gives `v_p = v₀ + A x_p`, `C_p = A`, and
+/// `F_E ← (I + Δt A) F_E`, `x_p ← x_p + Δt v_p`, up to the rounding of the node sums
+/// (a few ε of `|v|`, `|A|`).
+fn linear_field<const D: usize>()
+where
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<f64, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let dt = 1e-3;
+    let mut rng = Pcg64::seed_from_u64(21);
+    let a_m = rand_mat::<D>(&mut rng, 2.0);
+    let v0: [f64; D] = std::array::from_fn(|_| rng.random_range(-1.0..1.0));
+    let field = |x: [f64; D]| -> [f64; D] {
+        let ax = a_m.mul_vec(x);
+        std::array::from_fn(|a| v0[a] + ax[a])
+    };
+    let mat = materials::<f64>()[0].1;
+    for isa in Isa::available() {
+        for kernel in [Kernel::Quadratic, Kernel::Cubic] {
+            for mac in [false, true] {
+                let ps = particles::<f64, D>(&mut rng, 30, hf, cells, &mat);
+                let mut store = Store::from(&ps);
+                let mut col = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
+                fill(&mut col, Grid::Collocated, hf, field, |_| (0.0, 0.0));
+                let faces: [DenseGrid<f64, D>; D] = std::array::from_fn(|a| {
+                    let mut g = DenseGrid::<f64, D>::new([-2; D], [cells + 4; D]);
+                    fill(&mut g, Grid::Face(a), hf, field, |_| (0.0, 0.0));
+                    g
+                });
+                let fviews: [G2pView<f64, D>; D] = std::array::from_fn(|a| faces[a].g2p_view());
+                let args = G2pArgs { kernel, h: hf, dt };
+                let raw = store.raw();
+                // SAFETY: as above.
+                let st = unsafe {
+                    g2p::g2p_update(
+                        isa,
+                        &mat,
+                        &args,
+                        ps.len(),
+                        &raw,
+                        &col.g2p_view(),
+                        mac.then_some(&fviews),
+                    )
+                };
+                assert_eq!(st.error, None);
+                let scale = 2.0 * (cells as f64) * hf + 1.0;
+                let tol = 64.0 * f64::EPSILON * scale * 8.0;
+                for (i, p) in ps.iter().enumerate() {
+                    let q = store.get::<D>(i);
+                    let v = field(p.x);
+                    for a in 0..D {
+                        assert!((q.v[a] - v[a]).abs() <= tol, "{kernel:?} mac {mac}: v");
+                        assert!((q.x[a] - (p.x[a] + dt * q.v[a])).abs() <= 4.0 * f64::EPSILON);
+                        for b in 0..D {
+                            assert!(
+                                (q.affine.cols[b][a] - a_m.cols[b][a]).abs() <= tol / hf,
+                                "{kernel:?} mac {mac}: C[{a}][{b}] {} vs {}",
+                                q.affine.cols[b][a],
+                                a_m.cols[b][a]
+                            );
+                        }
+                    }
+                    let f_want = (Mat::<f64, D>::identity() + a_m * dt) * p.f_e;
+                    for j in 0..D {
+                        for r in 0..D {
+                            assert!((q.f_e.cols[j][r] - f_want.cols[j][r]).abs() <= tol * dt / hf);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn linear_field_is_reproduced_2d() {
+    linear_field::<2>();
+}
+#[test]
+fn linear_field_is_reproduced_3d() {
+    linear_field::<3>();
+}
+
+/// NaN in a node that a particle reads fails that particle (NonFinite) and leaves it as it
+/// was; NaN in nodes no stencil reads (a host's massless nodes) is harmless.
+#[test]
+fn g2p_reads_only_stencil_nodes() {
+    type T = f64;
+    const D: usize = 2;
+    let (cells, hf) = (16, 0.05);
+    let mat = materials::<T>()[0].1;
+    let mut rng = Pcg64::seed_from_u64(2);
+    let mut ps = particles::<T, D>(&mut rng, 10, hf, cells, &mat);
+    for p in ps.iter_mut() {
+        p.x[0] = 5.2 * hf;
+    }
+    let mut g = DenseGrid::<T, D>::new([-1; D], [cells + 2; D]);
+    for k in 0..g.ch[0].len() {
+        let ix = (k % g.dims[0] as usize) as i32 - 1;
+        let v = if ix > 8 { T::NAN } else { 0.5 };
+        g.ch[MOM][k] = v;
+        g.ch[MOM + 1][k] = v;
+    }
+    let mut store = Store::from(&ps);
+    let args = G2pArgs {
+        kernel: Kernel::Quadratic,
+        h: hf,
+        dt: 1e-3,
+    };
+    let raw = store.raw();
+    let isa = Isa::detect();
+    // SAFETY: as above.
+    let st = unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
+    assert_eq!(st.error, None);
+    let mut s2 = Store::from(&ps[..1]);
+    let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, hf, &ps[0].x).unwrap();
+    let i = g.index(s.node(4).index);
+    g.ch[MOM + 1][i] = T::NAN;
+    let raw = s2.raw();
+    // SAFETY: as above.
+    let st = unsafe { g2p::g2p_update(isa, &mat, &args, 1, &raw, &g.g2p_view(), None) };
+    assert_eq!((st.first_failed, st.error), (0, Some(Error::NonFinite)));
+    assert_eq!(s2, Store::from(&ps[..1]));
+}
