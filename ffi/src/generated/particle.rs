@@ -22,7 +22,7 @@ use core::ffi::{c_int, c_uint};
 /// contributions do not depend on its position in the batch.
 ///
 /// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
-/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 48 particles) is summed in a
 /// local block first and the block is added to the grid once, so the rounding of a node value
 /// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
 /// the call fast; any order gives the same sums to rounding.
@@ -66,7 +66,7 @@ pub unsafe extern "C" fn ampm_p2g_2d_f32(
 /// contributions do not depend on its position in the batch.
 ///
 /// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
-/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 48 particles) is summed in a
 /// local block first and the block is added to the grid once, so the rounding of a node value
 /// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
 /// the call fast; any order gives the same sums to rounding.
@@ -110,7 +110,7 @@ pub unsafe extern "C" fn ampm_p2g_2d_f64(
 /// contributions do not depend on its position in the batch.
 ///
 /// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
-/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 48 particles) is summed in a
 /// local block first and the block is added to the grid once, so the rounding of a node value
 /// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
 /// the call fast; any order gives the same sums to rounding.
@@ -154,7 +154,7 @@ pub unsafe extern "C" fn ampm_p2g_3d_f32(
 /// contributions do not depend on its position in the batch.
 ///
 /// Node sums (also ampm_force_apply_*): a run of consecutive particles whose stencils fit in one
-/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 16 particles) is summed in a
+/// block of 8 × (K + 1)^(d − 1) nodes (K nodes per axis; at most 48 particles) is summed in a
 /// local block first and the block is added to the grid once, so the rounding of a node value
 /// depends on the batch order. Sorting particles by cell (axis 0 fastest) makes runs long and
 /// the call fast; any order gives the same sums to rounding.

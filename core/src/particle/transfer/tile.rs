@@ -48,7 +48,7 @@ pub(super) const TILE_X: usize = 8;
 /// Most tile rows: `(K + 1)^{d−1}` up to the cubic kernel in 3D.
 pub(super) const MAX_ROWS: usize = 25;
 /// Most particles in a run (kept for the one-by-one path).
-pub(super) const MAX_RUN: usize = 16;
+pub(super) const MAX_RUN: usize = 48;
 /// Most channels written by one P2G call.
 pub(super) const MAX_CH: usize = 10;
 /// Largest dimension.
