@@ -29,6 +29,7 @@
 //! the origin, and `x_i − x_p = (o − fx) h` is formed without cancellation.
 
 use crate::error::{Error, Result};
+use crate::lane::Lane;
 use crate::scalar::Real;
 
 /// The B-spline interpolation kernel.
@@ -86,30 +87,45 @@ impl Kernel {
     #[inline(always)]
     #[must_use]
     pub fn n_dn<T: Real>(self, d: T) -> (T, T) {
+        self.n_dn_lanes(d)
+    }
+
+    /// [`Kernel::n_dn`] on every lane of `d`: each piece is evaluated and the lane takes the
+    /// piece of its `|d|` (the scalar path is this with one lane). The pieces are written
+    /// with separate multiplications and additions, never fused, so that the lanes and the
+    /// scalar give the same bits.
+    #[inline(always)]
+    pub(crate) fn n_dn_lanes<V: Lane>(self, d: V) -> (V, V) {
+        let c = |x: f64| V::splat(V::Scalar::from_f64(x));
         let ad = d.abs();
-        let three_halves = T::from_f64(1.5);
+        let zero = c(0.0);
         match self {
             Kernel::Quadratic => {
-                if ad < T::HALF {
-                    (T::from_f64(0.75) - d * d, -(d + d))
-                } else if ad < three_halves {
-                    let e = three_halves - ad;
-                    (T::HALF * e * e, -(e.copysign(d)))
-                } else {
-                    (T::ZERO, T::ZERO)
-                }
+                // |d| < ½: ¾ − d², −2d; ½ ≤ |d| < ³⁄₂: ½ e², −sign(d) e with e = ³⁄₂ − |d|.
+                let e = c(1.5) - ad;
+                let (n1, dn1) = (c(0.75) - d * d, -(d + d));
+                let (n2, dn2) = (c(0.5) * e * e, -(e.copysign(d)));
+                let (inner, outer) = (ad.lt(c(0.5)), ad.lt(c(1.5)));
+                (
+                    V::select(inner, n1, V::select(outer, n2, zero)),
+                    V::select(inner, dn1, V::select(outer, dn2, zero)),
+                )
             }
             Kernel::Cubic => {
-                if ad < T::ONE {
-                    // ½|d|³ − d² + ⅔, derivative (3/2)|d|d − 2d.
-                    let n = (T::HALF * ad - T::ONE) * d * d + T::TWO / T::from_i32(3);
-                    (n, (three_halves * ad - T::TWO) * d)
-                } else if ad < T::TWO {
-                    let e = T::TWO - ad;
-                    (e * e * e / T::from_i32(6), -((T::HALF * e * e).copysign(d)))
-                } else {
-                    (T::ZERO, T::ZERO)
-                }
+                // |d| < 1: ½|d|³ − d² + ⅔, (3/2)|d|d − 2d; 1 ≤ |d| < 2: e³/6, −sign(d) ½e²
+                // with e = 2 − |d|.
+                let two = V::Scalar::TWO;
+                let third2 = V::splat(two / V::Scalar::from_i32(3));
+                let n1 = (c(0.5) * ad - c(1.0)) * d * d + third2;
+                let dn1 = (c(1.5) * ad - c(2.0)) * d;
+                let e = c(2.0) - ad;
+                let n2 = e * e * e / c(6.0);
+                let dn2 = -((c(0.5) * e * e).copysign(d));
+                let (inner, outer) = (ad.lt(c(1.0)), ad.lt(c(2.0)));
+                (
+                    V::select(inner, n1, V::select(outer, n2, zero)),
+                    V::select(inner, dn1, V::select(outer, dn2, zero)),
+                )
             }
         }
     }
@@ -171,14 +187,7 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     #[inline(always)]
     pub fn new(kernel: Kernel, grid: Grid, h: T, x: &[T; D]) -> Result<Self> {
         let inv_h = Self::inv_spacing(grid, h, x)?;
-        let mut s = Self {
-            kernel,
-            h,
-            base: [0; D],
-            fx: [T::ZERO; D],
-            w: [[T::ZERO; 4]; D],
-            dw: [[T::ZERO; 4]; D],
-        };
+        let mut s = Self::blank(kernel, h);
         for a in 0..D {
             let (xi, xi64) = cell_coordinate(grid, a, inv_h, x[a])?;
             // ⌊ξ⌋ by truncation (|ξ| < 2³⁰ was checked, so the conversion is exact).
@@ -207,6 +216,19 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         Ok(s)
     }
 
+    /// A stencil with every weight 0 and base 0 (a placeholder to be overwritten).
+    #[inline(always)]
+    pub(crate) fn blank(kernel: Kernel, h: T) -> Self {
+        Self {
+            kernel,
+            h,
+            base: [0; D],
+            fx: [T::ZERO; D],
+            w: [[T::ZERO; 4]; D],
+            dw: [[T::ZERO; 4]; D],
+        }
+    }
+
     /// Checks what [`Stencil::new`] checks about `h` and `x` without building the stencil:
     /// `Ok` exactly when `Stencil::new(_, grid, h, x)` is.
     ///
@@ -218,6 +240,84 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             cell_coordinate(grid, a, inv_h, x[a])?;
         }
         Ok(())
+    }
+
+    /// The stencils of `V::LANES` particles at once (positions `xs[l]`) on SIMD lanes, into
+    /// `out[l]`. Returns the lanes done (bit `l` for lane `l`): there `out[l]` is
+    /// `Stencil::new(kernel, grid, h, &xs[l])` with the same bits. A lane is not done when
+    /// its `Stencil::new` would fail (or `h` or `grid` is invalid: no lane is done); the
+    /// caller calls `Stencil::new` there and gets its error.
+    ///
+    /// Same operations per lane as [`Stencil::new`]: `ξ = x/h − shift`, `⌊ξ⌋` (exact in `T`
+    /// for `|ξ| < 2³⁰`: a value of `T` that large is an integer), `frac = ξ − ⌊ξ⌋`, the base
+    /// choice, and [`Kernel::n_dn_lanes`].
+    #[inline(always)]
+    pub(crate) fn new_lanes<V: Lane<Scalar = T>>(
+        kernel: Kernel,
+        grid: Grid,
+        h: T,
+        xs: &[[T; D]],
+        out: &mut [Self],
+    ) -> u32 {
+        const MAX: usize = 32;
+        let n = V::LANES;
+        debug_assert!(n <= MAX && xs.len() >= n && out.len() >= n);
+        let inv_h = T::ONE / h;
+        let bad_face = matches!(grid, Grid::Face(f) if f >= D);
+        if !(h.is_finite() && h > T::ZERO && inv_h.is_finite()) || bad_face {
+            return 0;
+        }
+        let mut done = u32::MAX >> (32 - n);
+        let mut buf = [T::ZERO; MAX];
+        let (mut lo_buf, mut fl_buf) = ([T::ZERO; MAX], [T::ZERO; MAX]);
+        let k = kernel.width();
+        for a in 0..D {
+            for (b, x) in buf.iter_mut().zip(xs).take(n) {
+                *b = x[a];
+            }
+            let shift = match grid {
+                Grid::Face(f) if f != a => T::HALF,
+                _ => T::ZERO,
+            };
+            let xi = V::load(&buf[..n]) * V::splat(inv_h) - V::splat(shift);
+            // Finite and inside the position limit (false for NaN and infinities).
+            done &= V::mask_bits(xi.abs().lt(V::splat(T::from_f64(MAX_CELLS))));
+            let fl = xi.floor();
+            let frac = xi - fl;
+            let one = V::splat(T::ONE);
+            // Quadratic: base ⌊ξ − ½⌋ (one less where frac < ½); cubic: ⌊ξ⌋ − 1.
+            let lo = match kernel {
+                Kernel::Quadratic => V::select(frac.lt(V::splat(T::HALF)), one, V::splat(T::ZERO)),
+                Kernel::Cubic => one,
+            };
+            let fx = frac + lo;
+            fl.store(&mut fl_buf[..n]);
+            lo.store(&mut lo_buf[..n]);
+            fx.store(&mut buf[..n]);
+            for (l, st) in out.iter_mut().enumerate().take(n) {
+                st.base[a] = (fl_buf[l].to_f64() as i32).wrapping_sub(lo_buf[l].to_f64() as i32);
+                st.fx[a] = buf[l];
+            }
+            for st in out.iter_mut().take(n) {
+                // Unused entries are 0, as in `Stencil::new`.
+                st.w[a][k..].fill(T::ZERO);
+                st.dw[a][k..].fill(T::ZERO);
+            }
+            for o in 0..k {
+                let (w, dw) = kernel.n_dn_lanes(fx - V::splat(T::from_i32(o as i32)));
+                w.store(&mut buf[..n]);
+                (dw * V::splat(inv_h)).store(&mut fl_buf[..n]);
+                for (l, st) in out.iter_mut().enumerate().take(n) {
+                    st.w[a][o] = buf[l];
+                    st.dw[a][o] = fl_buf[l];
+                }
+            }
+        }
+        for st in out.iter_mut().take(n) {
+            st.kernel = kernel;
+            st.h = h;
+        }
+        done
     }
 
     /// Validates `grid`, `h` and the finiteness of `x`; returns `1/h`.
@@ -326,3 +426,6 @@ fn cell_coordinate<T: Real>(grid: Grid, a: usize, inv_h: T, x: T) -> Result<(T, 
     }
     Ok((xi, xi64))
 }
+
+#[cfg(all(test, feature = "std"))]
+mod tests;

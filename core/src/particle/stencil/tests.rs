@@ -1,0 +1,185 @@
+//! The stencils on lanes ([`Stencil::new_lanes`]) against the scalar [`Stencil::new`], bit for
+//! bit, on every lane type the CPU has.
+
+use super::{Grid, Kernel, Stencil, MAX_CELLS};
+use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp};
+use crate::lane::{Isa, Lane};
+use crate::scalar::Real;
+use std::vec::Vec;
+
+/// The bits of a stencil (a `Stencil`'s `==` would take −0 for +0).
+fn bits<T: Real, const D: usize>(s: &Stencil<T, D>) -> Vec<u64> {
+    let mut v = std::vec![s.kernel.width() as u64, s.h.to_f64().to_bits()];
+    for a in 0..D {
+        v.push(s.base[a] as i64 as u64);
+        v.push(s.fx[a].to_f64().to_bits());
+        for o in 0..4 {
+            v.push(s.w[a][o].to_f64().to_bits());
+            v.push(s.dw[a][o].to_f64().to_bits());
+        }
+    }
+    v
+}
+
+/// Runs `new_lanes` on the kernel lanes `V` and the row lanes `R` of an instruction set and
+/// compares every lane with `Stencil::new`.
+struct Check<'a, T, const D: usize> {
+    kernel: Kernel,
+    grid: Grid,
+    h: T,
+    xs: &'a [[T; D]],
+    /// Lanes done, summed over both lane types and every chunk.
+    done: usize,
+}
+
+impl<T: Real, const D: usize> Check<'_, T, D> {
+    fn lanes<V: Lane<Scalar = T>>(&mut self) {
+        let n = V::LANES;
+        for chunk in self.xs.chunks(n) {
+            let mut xs = [[T::ZERO; D]; 32];
+            xs[..chunk.len()].copy_from_slice(chunk);
+            // Placeholders with values that a lane must overwrite.
+            let mut out = [Stencil::blank(Kernel::Cubic, T::from_i32(7)); 32];
+            for s in out.iter_mut() {
+                s.w = [[T::from_i32(9); 4]; D];
+                s.base = [-5; D];
+            }
+            let done = Stencil::new_lanes::<V>(self.kernel, self.grid, self.h, &xs[..n], &mut out);
+            for (l, x) in xs.iter().enumerate().take(n) {
+                let want = Stencil::new(self.kernel, self.grid, self.h, x);
+                let on = done >> l & 1 == 1;
+                assert_eq!(
+                    on,
+                    want.is_ok(),
+                    "lane {l} of {n} at {x:?}: done vs {want:?}"
+                );
+                if let Ok(w) = want {
+                    assert_eq!(bits(&out[l]), bits(&w), "lane {l} of {n} at {x:?}");
+                    self.done += 1;
+                }
+            }
+        }
+    }
+}
+
+impl<T: Real, const D: usize> LaneOp<T> for Check<'_, T, D> {
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        self.lanes::<V>();
+        BatchStatus {
+            first_failed: 0,
+            error: None,
+        }
+    }
+
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        self.lanes::<R>();
+        self.run::<V>()
+    }
+}
+
+/// Positions in cells: random ones, every kernel branch boundary (integers, halves, ±0),
+/// negative ones, the position limit on both sides, and non-finite ones.
+fn positions<T: Real, const D: usize>(h: f64) -> Vec<[T; D]> {
+    let mut rng = 0x2545_f491_4f6c_dd1d_u64;
+    let mut next = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64
+    };
+    let mut cells: Vec<f64> = std::vec![0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 1.5, 2.0, 2.5, -2.5];
+    for k in 1..30 {
+        let e = f64::from(k);
+        cells.extend([
+            2f64.powf(e),
+            -2f64.powf(e),
+            2f64.powf(e) + 0.5,
+            2f64.powf(e) - 0.25,
+        ]);
+    }
+    let lim = MAX_CELLS;
+    cells.extend([
+        lim,
+        -lim,
+        lim * (1.0 - 1e-9),
+        -lim * (1.0 - 1e-9),
+        1e-40,
+        -1e-300,
+    ]);
+    for _ in 0..200 {
+        cells.push((next() - 0.5) * 200.0);
+        cells.push((next() - 0.5) * 2e6);
+    }
+    let special = [f64::NAN, f64::INFINITY, f64::NEG_INFINITY, 1e300];
+    let mut out = Vec::new();
+    for (i, &c) in cells.iter().enumerate() {
+        let mut x = [T::ZERO; D];
+        for (a, xa) in x.iter_mut().enumerate() {
+            // Each axis from another entry, so that axes differ.
+            let ca = cells[(i + 7 * a) % cells.len()];
+            let cell = if a == 0 { c } else { ca };
+            *xa = T::from_f64(cell * h);
+        }
+        out.push(x);
+    }
+    for (i, &s) in special.iter().enumerate() {
+        let mut x = [T::from_f64(1.25 * h); D];
+        x[i % D] = T::from_f64(s);
+        out.push(x);
+    }
+    out
+}
+
+fn compare<T: BatchReal, const D: usize>() {
+    let mut total = 0;
+    for isa in Isa::available() {
+        for kernel in [Kernel::Quadratic, Kernel::Cubic] {
+            let mut grids = std::vec![Grid::Collocated];
+            grids.extend((0..D).map(Grid::Face));
+            for grid in grids {
+                for h in [1.0, 0.1, 3e-3] {
+                    let xs = positions::<T, D>(h);
+                    let mut c = Check {
+                        kernel,
+                        grid,
+                        h: T::from_f64(h),
+                        xs: &xs,
+                        done: 0,
+                    };
+                    dispatch::<T, _>(isa, &mut c);
+                    total += c.done;
+                }
+            }
+        }
+    }
+    // Most positions are inside the limit: the comparison ran on them.
+    assert!(total > 1000, "{total}");
+}
+
+#[test]
+fn lanes_give_the_scalar_stencils_2d_f32() {
+    compare::<f32, 2>();
+}
+
+#[test]
+fn lanes_give_the_scalar_stencils_3d_f32() {
+    compare::<f32, 3>();
+}
+
+#[test]
+fn lanes_give_the_scalar_stencils_3d_f64() {
+    compare::<f64, 3>();
+}
+
+/// An invalid spacing or face axis: no lane is done (each lane's `Stencil::new` reports it).
+#[test]
+fn invalid_spacing_or_face_does_no_lane() {
+    let xs = [[0.25f32; 3]; 8];
+    let mut out = [Stencil::blank(Kernel::Quadratic, 1.0); 8];
+    for h in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e-45] {
+        let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Collocated, h, &xs, &mut out);
+        assert_eq!(d, 0, "h = {h}");
+    }
+    let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Face(3), 1.0, &xs, &mut out);
+    assert_eq!(d, 0);
+}
