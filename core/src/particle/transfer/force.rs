@@ -177,7 +177,11 @@ where
             let mut out = [[T::ZERO; MAX_LANES]; 25];
             let mut chk = V::splat(T::ZERO);
             entries(&b, |o, v| {
-                chk += v - v;
+                // v − v is 0 for finite v and NaN otherwise: one finiteness sum per lane.
+                #[allow(clippy::eq_op)]
+                {
+                    chk += v - v;
+                }
                 v.store(&mut out[o][..lanes]);
             });
             let mut ok_bits = [T::ZERO; MAX_LANES];
@@ -290,7 +294,9 @@ where
     /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`): each particle's
     /// `δf` goes into a node tile ([`super::tile`]) that is added to `df` per run of nearby
     /// particles; a run whose sum would not be finite is added again one particle at a time
-    /// ([`one`]), which refuses the particles that overflow.
+    /// ([`one`]), which refuses the particles that overflow. Particles go in chunks of
+    /// [`TILE_X`]: the chunk's stencils on lanes, then each particle's `M` (reads of `δu`,
+    /// written in place), then the tile (writes of `δf`, which no read of `δu` sees).
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
@@ -299,43 +305,99 @@ where
         let mut tile = Tile::<R, D>::new();
         let mut run = [0usize; MAX_RUN];
         let mut nrun = 0;
-        for i in 0..self.n {
-            // SAFETY: `apply`'s contract. (A `match`, not a closure: a closure is not always
-            // inlined into the caller's target features.)
-            let (s, rel, m) = match unsafe { self.gather::<R, K, N>(i, &cst) } {
-                Ok(g) => g,
-                Err(e) => {
-                    first.note(i, Err(e));
-                    continue;
-                }
-            };
-            let fits = if nrun < MAX_RUN {
-                tile.place::<K>(&rel, &s.fx)
-            } else {
-                None
-            };
-            let sp = match fits {
-                Some(sp) => sp,
-                None => {
-                    // SAFETY: as above.
-                    unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &cst, &mut first) };
-                    nrun = 0;
-                    // An empty tile takes any stencil.
-                    tile.place::<K>(&rel, &s.fx).unwrap_or([0; D])
-                }
-            };
-            let (w, dw) = axis0::<T, R, D, K>(&s, sp[0]);
-            let mut coef = [Coef::only(R::splat(T::ZERO)); D];
-            for (a, c) in coef.iter_mut().enumerate() {
-                set_grad(c, w, dw, &m, a, T::ONE);
+        let (kernel, h) = (self.kernel, self.h);
+        let mut xs = [[T::ZERO; D]; TILE_X];
+        let mut stencils = [Stencil::blank(kernel, h); TILE_X];
+        let mut rels = [[0isize; D]; TILE_X];
+        let mut ms = [Mat::<T, D>::ZERO; TILE_X];
+        let mut live = [false; TILE_X];
+        let mut start = 0;
+        while start < self.n {
+            let len = TILE_X.min(self.n - start);
+            for (k, x) in xs.iter_mut().enumerate().take(len) {
+                // SAFETY: `apply`'s contract (particle `start + k < n`).
+                *x = unsafe { rd_vec::<T, D>(self.x, start + k) };
             }
-            tile.add::<K, N>(&sp, &factors::<T, D, K, N>(&s), &coef);
-            run[nrun] = i;
-            nrun += 1;
+            let done = if R::LANES == TILE_X {
+                Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, &xs, &mut stencils)
+            } else {
+                0
+            };
+            for k in 0..len {
+                // SAFETY: as above.
+                let r = unsafe {
+                    self.gather_with::<R, K, N>(
+                        start + k,
+                        &xs[k],
+                        done >> k & 1 == 1,
+                        &cst,
+                        &mut stencils[k],
+                        &mut rels[k],
+                        &mut ms[k],
+                    )
+                };
+                live[k] = r.is_ok();
+                first.note(start + k, r);
+            }
+            for k in 0..len {
+                if live[k] {
+                    // SAFETY: as above.
+                    unsafe {
+                        self.tile_add::<R, K, N>(
+                            start + k,
+                            (&stencils[k], &rels[k], &ms[k]),
+                            &mut tile,
+                            (&mut run, &mut nrun),
+                            &cst,
+                            &mut first,
+                        )
+                    };
+                }
+            }
+            start += len;
         }
         // SAFETY: as above.
         unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &cst, &mut first) };
         first.status()
+    }
+
+    /// Adds particle `i` (its stencil, box-relative base and `M`) to the tile run, after
+    /// adding the run to `df` if the particle does not fit or the run is full.
+    ///
+    /// # Safety
+    /// `apply`'s contract.
+    #[inline(always)]
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        i: usize,
+        (s, rel, m): (&Stencil<T, D>, &[isize; D], &Mat<T, D>),
+        tile: &mut Tile<R, D>,
+        (run, nrun): (&mut [usize; MAX_RUN], &mut usize),
+        cst: &[[T; 8]; N],
+        first: &mut FirstFailure,
+    ) {
+        let fits = if *nrun < MAX_RUN {
+            tile.place::<K>(rel, &s.fx)
+        } else {
+            None
+        };
+        let sp = match fits {
+            Some(sp) => sp,
+            None => {
+                self.flush::<R, K, N>(tile, &run[..*nrun], cst, first);
+                *nrun = 0;
+                // An empty tile takes any stencil.
+                tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
+            }
+        };
+        let (w, dw) = axis0::<T, R, D, K>(s, sp[0]);
+        let mut coef = [Coef::only(R::splat(T::ZERO)); D];
+        for (a, c) in coef.iter_mut().enumerate() {
+            set_grad(c, w, dw, m, a, T::ONE);
+        }
+        tile.add::<K, N>(&sp, &factors::<T, D, K, N>(s), &coef);
+        run[*nrun] = i;
+        *nrun += 1;
     }
 
     /// Particle `i`'s stencil, box-relative base and `M = 𝒜(G)`.
@@ -348,16 +410,44 @@ where
         i: usize,
         cst: &[[T; 8]; N],
     ) -> Result<(Stencil<T, D>, [isize; D], Mat<T, D>)> {
+        let xp = rd_vec::<T, D>(self.x, i);
+        let mut s = Stencil::blank(self.kernel, self.h);
+        let (mut rel, mut m) = ([0; D], Mat::ZERO);
+        self.gather_with::<R, K, N>(i, &xp, false, cst, &mut s, &mut rel, &mut m)?;
+        Ok((s, rel, m))
+    }
+
+    /// [`Self::gather`] of particle `i` at `xp` into `s`, `rel`, `m` (in part on error; built
+    /// in place, for the reason given at [`super::Particles::read_into`]); with `lane`, `s`
+    /// already holds the stencil of `xp` ([`Stencil::new_lanes`]). Statuses in the order of
+    /// the checks: slot, stencil, box, `δu`.
+    ///
+    /// # Safety
+    /// `apply`'s contract.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn gather_with<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        i: usize,
+        xp: &[T; D],
+        lane: bool,
+        cst: &[[T; 8]; N],
+        s: &mut Stencil<T, D>,
+        rel: &mut [isize; D],
+        m: &mut Mat<T, D>,
+    ) -> Result<()> {
         let sl = slot_len(D);
         let slot = core::slice::from_raw_parts(self.slots.add(i * sl), sl);
         if slot[0] != tag::<T>(D) {
             return Err(Error::NotPrepared);
         }
-        let xp = rd_vec::<T, D>(self.x, i);
-        let s = Stencil::new(self.kernel, Grid::Collocated, self.h, &xp)?;
-        let rel = rel_base(&s, &self.view.nodes)?;
-        let g = grad_u::<T, R, D, K, N>(&s, &rel, self.view, cst)?;
-        Ok((s, rel, apply_slot(slot, &g)))
+        if !lane {
+            *s = Stencil::new(self.kernel, Grid::Collocated, self.h, xp)?;
+        }
+        *rel = rel_base(s, &self.view.nodes)?;
+        let g = grad_u::<T, R, D, K, N>(s, rel, self.view, cst)?;
+        *m = apply_slot(slot, &g);
+        Ok(())
     }
 
     /// Adds the tile to `df`; if that would write a non-finite value, adds the run's particles

@@ -159,27 +159,66 @@ where
         // Chunks of elastic solids or of liquids are updated on the row type's eight lanes.
         let lanes = update_lanes::on_lanes(self.material) && R::LANES == CHUNK;
         let mut cs = ChunkSamples::new();
+        // The chunk's samples and their statuses, written in place: a sample returned by value
+        // (in a `Result`) is copied with wide moves right after its fields were stored one by
+        // one, and such a copy waits for the stores to reach the cache.
+        let zero = G2pSample {
+            v: [T::ZERO; D],
+            affine: Mat::ZERO,
+            grad_v: Mat::ZERO,
+            t_pic: T::ZERO,
+            t_flip: T::ZERO,
+        };
+        let mut samples = [zero; CHUNK];
+        let mut status = [Ok(()); CHUNK];
+        // The chunk's positions and collocated stencils (on lanes, see `Stencil::new_lanes`).
+        let (kernel, h) = (self.args.kernel, self.args.h);
+        let mut xs = [[T::ZERO; D]; CHUNK];
+        let mut stencils = [Stencil::blank(kernel, h); CHUNK];
         let mut start = 0;
         while start < self.n {
             let len = CHUNK.min(self.n - start);
-            let mut samples = [Err(Error::NonFinite); CHUNK];
-            let mut all_ok = true;
-            for (k, out) in samples.iter_mut().enumerate().take(len) {
+            for (k, x) in xs.iter_mut().enumerate().take(len) {
                 // SAFETY: `g2p_update`'s contract (particle `start + k < n`).
-                *out = unsafe {
-                    let x = rd_vec::<T, D>(self.ps.x, start + k);
-                    sample::<T, R, D, K, N>(
-                        self.material,
-                        self.args,
-                        &x,
-                        self.view,
-                        self.faces,
-                        &cst,
-                    )
+                *x = unsafe { rd_vec::<T, D>(self.ps.x, start + k) };
+            }
+            let done = if R::LANES == CHUNK {
+                Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, &xs, &mut stencils)
+            } else {
+                0
+            };
+            let mut all_ok = true;
+            for (k, (out, st)) in samples.iter_mut().zip(&mut status).enumerate().take(len) {
+                *st = if done >> k & 1 == 1 {
+                    Ok(())
+                } else {
+                    match Stencil::new(kernel, Grid::Collocated, h, &xs[k]) {
+                        Ok(s) => {
+                            stencils[k] = s;
+                            Ok(())
+                        }
+                        Err(e) => Err(e),
+                    }
                 };
-                match out {
-                    Ok(smp) if lanes => cs.set(k, smp),
-                    _ => all_ok = false,
+                if st.is_ok() {
+                    // SAFETY: `g2p_update`'s contract.
+                    *st = unsafe {
+                        sample::<T, R, D, K, N>(
+                            self.material,
+                            self.args,
+                            &xs[k],
+                            &stencils[k],
+                            self.view,
+                            self.faces,
+                            &cst,
+                            out,
+                        )
+                    };
+                }
+                if lanes && st.is_ok() {
+                    cs.set(k, out);
+                } else {
+                    all_ok = false;
                 }
             }
             // SAFETY: as above; `on_lanes(material)` when `lanes`.
@@ -201,7 +240,7 @@ where
                 start += len;
                 continue;
             }
-            for (k, smp) in samples.iter().enumerate().take(len) {
+            for (k, (smp, st)) in samples.iter().zip(&status).enumerate().take(len) {
                 // SAFETY: as above.
                 let r = unsafe {
                     update_one(
@@ -209,7 +248,7 @@ where
                         &self.checked,
                         self.args,
                         self.ps,
-                        smp,
+                        st.map(|()| smp),
                         start + k,
                     )
                 };
@@ -232,7 +271,7 @@ unsafe fn update_one<T: Real, const D: usize>(
     checked: &Checked,
     args: &G2pArgs<T>,
     ps: &Particles<T>,
-    sample: &Result<G2pSample<T, D>>,
+    sample: Result<&G2pSample<T, D>>,
     i: usize,
 ) -> Result<()>
 where
@@ -246,9 +285,9 @@ where
     };
     let p = ps.get::<D>(i, reads, material)?;
     checked.for_phase(p.phase)?;
-    let sample = (*sample)?;
+    let sample = sample?;
     // The material was validated for this phase above (`checked`).
-    let (out, _) = update_validated(material, args.dt, &sample, &p)?;
+    let (out, _) = update_validated(material, args.dt, sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
         // The cell index of the new position is beyond the supported range (as g2p_update).
         return Err(Error::Overflow);
@@ -341,23 +380,26 @@ unsafe fn temperatures<
     (pic, flip, chk)
 }
 
-/// The grid sample of a particle at `x`.
+/// The grid sample of a particle at `x` with collocated stencil `s`, written to `out` (in
+/// part on error).
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 unsafe fn sample<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
     material: &Material<T>,
     args: &G2pArgs<T>,
     x: &[T; D],
+    s: &Stencil<T, D>,
     view: &G2pView<T, D>,
     faces: Option<&[G2pView<T, D>; D]>,
     cst: &[[T; 8]; N],
-) -> Result<G2pSample<T, D>>
+    out: &mut G2pSample<T, D>,
+) -> Result<()>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    let s = Stencil::new(args.kernel, Grid::Collocated, args.h, x)?;
     // The collocated box is read for velocities (collocated grid) and temperatures (heat on).
     let rel = if faces.is_none() || material.heat.is_some() {
-        rel_base(&s, &view.nodes)?
+        rel_base(s, &view.nodes)?
     } else {
         [0; D]
     };
@@ -366,13 +408,8 @@ where
     if !inv_kh.is_finite() {
         return Err(Error::Overflow);
     }
-    let mut out = G2pSample {
-        v: [T::ZERO; D],
-        affine: Mat::ZERO,
-        grad_v: Mat::ZERO,
-        t_pic: T::ZERO,
-        t_flip: T::ZERO,
-    };
+    out.t_pic = T::ZERO;
+    out.t_flip = T::ZERO;
     let mut finite = true;
     let mut put = |a: usize, st: &Stencil<T, D>, v: &[T; D], so: &[[T; D]; D], g: &[[T; D]; D]| {
         out.v[a] = v[a];
@@ -382,13 +419,13 @@ where
         }
     };
     // The collocated stencil's nodes, once for its velocities and temperatures.
-    let m = rows::<T, R, D, K, N>(&s, cst);
+    let m = rows::<T, R, D, K, N>(s, cst);
     match faces {
         None => {
             let (v, so, g, ok) = sums::<T, R, D, K, N>(&m, &rel, &view.velocity, (0, D));
             finite &= ok;
             for a in 0..D {
-                put(a, &s, &v, &so, &g);
+                put(a, s, &v, &so, &g);
             }
         }
         Some(f) => {
@@ -421,5 +458,5 @@ where
     if !(chk && out.affine.is_finite() && out.grad_v.is_finite()) {
         return Err(Error::Overflow);
     }
-    Ok(out)
+    Ok(())
 }

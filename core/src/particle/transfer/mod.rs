@@ -257,29 +257,59 @@ impl<T: Real> Particles<T> {
         reads: Reads,
         material: &Material<T>,
     ) -> Result<Particle<T, D>> {
-        let mut p = Particle::<T, D>::at_rest([T::ZERO; D], T::ONE, rd(self.volume0, i));
-        if reads.x {
-            p.x = rd_vec(self.x, i);
-        }
+        let mut p = Particle::<T, D>::at_rest([T::ZERO; D], T::ONE, T::ONE);
+        self.read_into(i, reads, material, &mut p)?;
+        Ok(p)
+    }
+
+    /// [`Particles::get`] into `p` (every field is written; on error, the phase is not). For
+    /// the transfer loops: a particle built in place is not copied again with wide moves
+    /// right after its fields were stored one by one (such a copy waits for the stores to
+    /// reach the cache).
+    ///
+    /// # Safety
+    /// As [`Particles::get`].
+    #[inline(always)]
+    pub(crate) unsafe fn read_into<const D: usize>(
+        &self,
+        i: usize,
+        reads: Reads,
+        material: &Material<T>,
+        p: &mut Particle<T, D>,
+    ) -> Result<()> {
+        let heat = material.heat.is_some();
+        p.x = if reads.x {
+            rd_vec(self.x, i)
+        } else {
+            [T::ZERO; D]
+        };
         if reads.motion {
             p.v = rd_vec(self.v, i);
             p.affine = rd_mat(self.affine, i);
+        } else {
+            p.v = [T::ZERO; D];
+            p.affine = Mat::ZERO;
         }
-        if reads.mass {
-            p.mass = rd(self.mass, i);
-            if material.heat.is_some() {
-                p.temperature = rd(self.temperature, i);
-            }
-        }
+        p.mass = if reads.mass { rd(self.mass, i) } else { T::ONE };
+        p.temperature = if reads.mass && heat {
+            rd(self.temperature, i)
+        } else {
+            T::ZERO
+        };
+        p.volume0 = rd(self.volume0, i);
         p.f_e = rd_mat(self.f_e, i);
         p.f_p = rd_mat(self.f_p, i);
-        if material.heat.is_some_and(|h| h.phase_change) {
-            p.latent = rd(self.latent, i);
-        }
-        if !self.phase.is_null() {
-            p.phase = Phase::from_code(rd(self.phase, i))?;
-        }
-        Ok(p)
+        p.latent = if material.heat.is_some_and(|h| h.phase_change) {
+            rd(self.latent, i)
+        } else {
+            T::ZERO
+        };
+        p.phase = if self.phase.is_null() {
+            Phase::Solid
+        } else {
+            Phase::from_code(rd(self.phase, i))?
+        };
+        Ok(())
     }
 
     /// Writes back what G2P changes.

@@ -26,6 +26,7 @@ use crate::particle::dilation;
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::check_particle;
 use crate::particle::{Dilation, Material, Particle};
+use crate::scalar::Real;
 use core::mem::MaybeUninit;
 
 /// Where P2G writes: a node box and the channels to scatter-add into (absent channels are
@@ -71,8 +72,8 @@ struct Run<T, const D: usize> {
 
 /// A particle ready for its node loop.
 #[derive(Clone, Copy)]
-struct Ready<T, const D: usize> {
-    s: Stencil<T, D>,
+struct Ready<'s, T, const D: usize> {
+    s: &'s Stencil<T, D>,
     /// `m v − m C h fx`: the momentum density at offset 0.
     q0: [T; D],
     /// `m C h`: the momentum density grows by column `b` per unit offset along `b`.
@@ -167,38 +168,73 @@ struct Pre<T, const D: usize> {
     mu: T,
 }
 
+impl<T: Real, const D: usize> Pre<T, D> {
+    /// A placeholder to be overwritten by [`P2gOp::pre_into`].
+    #[inline(always)]
+    fn blank() -> Self {
+        Self {
+            p: Particle::at_rest([T::ZERO; D], T::ONE, T::ONE),
+            j_e: T::ONE,
+            inv_lambda: T::ZERO,
+            mu: T::ZERO,
+        }
+    }
+}
+
 impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
+    /// The scalar pass of particle `i`, into `out` (in part on error): built in place, for
+    /// the reason given at [`Particles::read_into`].
     #[inline(always)]
-    unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
+    unsafe fn pre_into(&self, i: usize, out: &mut Pre<T, D>) -> Result<()> {
         let reads = Reads {
             x: true,
             motion: true,
             mass: true,
         };
-        let p = self.ps.get::<D>(i, reads, self.material)?;
+        self.ps
+            .read_into::<D>(i, reads, self.material, &mut out.p)?;
+        let p = &out.p;
         self.checked.for_phase(p.phase)?;
-        let (j_e, j_p) = check_particle(&p)?;
+        let (j_e, j_p) = check_particle(p)?;
         if self.material.heat.is_some() && !p.temperature.is_finite() {
             return Err(Error::NonFinite);
         }
         let m = self.material.moduli(p.phase, j_p)?;
-        Ok(Pre {
-            p,
-            j_e,
-            inv_lambda: m.inv_lambda,
-            mu: m.mu,
-        })
+        out.j_e = j_e;
+        out.inv_lambda = m.inv_lambda;
+        out.mu = m.mu;
+        Ok(())
     }
 
-    /// The node loop inputs of a particle with deviatoric Kirchhoff stress `tau_dev`.
+    /// [`Self::pre_into`], returned.
     #[inline(always)]
-    fn ready(&self, pre: &Pre<T, D>, tau_dev: Mat<T, D>) -> Result<Ready<T, D>> {
+    unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
+        let mut out = Pre::blank();
+        self.pre_into(i, &mut out)?;
+        Ok(out)
+    }
+
+    /// The stencil of a particle at `x` on this call's grid.
+    #[inline(always)]
+    fn stencil(&self, x: &[T; D]) -> Result<Stencil<T, D>> {
+        let a = self.args;
+        Stencil::new(a.kernel, a.grid, a.h, x)
+    }
+
+    /// The node loop inputs of a particle with deviatoric Kirchhoff stress `tau_dev` and
+    /// stencil `s` ([`Self::stencil`] of its position).
+    #[inline(always)]
+    fn ready<'s>(
+        &self,
+        pre: &Pre<T, D>,
+        tau_dev: Mat<T, D>,
+        s: &'s Stencil<T, D>,
+    ) -> Result<Ready<'s, T, D>> {
         let p = &pre.p;
         let a = self.args;
-        let s = Stencil::new(a.kernel, a.grid, a.h, &p.x)?;
         let mut tau = tau_dev;
         if self.material.dilation == Dilation::Explicit {
             let k = dilation::kirchhoff(pre.j_e, pre.inv_lambda)?;
@@ -248,13 +284,13 @@ where
     #[inline(always)]
     unsafe fn scatter<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
-        r: &Ready<T, D>,
+        r: &Ready<'_, T, D>,
         oc: &[[T; N]; D],
     ) -> Result<()> {
-        let rel = rel_base(&r.s, &self.view.nodes)?;
+        let rel = rel_base(r.s, &self.view.nodes)?;
         let comps = self.comps();
         let act = self.outs[..self.na].iter().zip(&self.kinds[..self.na]);
-        let nd = nodes::<T, D, K, N>(&r.s);
+        let nd = nodes::<T, D, K, N>(r.s);
         let idt = self.args.impulse_dt;
         // The force on the nodes along axis `a`.
         // The node forces along the written axes, once for the momentum and force channels.
@@ -349,12 +385,12 @@ where
     #[inline(always)]
     fn set_coef<R: Lane<Scalar = T>, const K: usize>(
         &self,
-        r: &Ready<T, D>,
+        r: &Ready<'_, T, D>,
         s0: usize,
         out: &mut [Coef<R, D>; MAX_CH],
     ) {
         let sp = R::splat;
-        let (w, dw) = axis0::<T, R, D, K>(&r.s, s0);
+        let (w, dw) = axis0::<T, R, D, K>(r.s, s0);
         // The axis-0 node offsets o₀ of the lanes (exact small integers).
         let mut lane = [T::ZERO; TILE_X];
         for (l, x) in lane.iter_mut().enumerate() {
@@ -394,14 +430,14 @@ where
     unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
-        r: &Ready<T, D>,
+        r: &Ready<'_, T, D>,
         tau_dev: Mat<T, D>,
         tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) -> Result<()> {
-        let rel = rel_base(&r.s, &self.view.nodes)?;
+        let rel = rel_base(r.s, &self.view.nodes)?;
         if run.n == MAX_RUN {
             self.flush::<R, K, N>(tile, run, oc);
         }
@@ -413,7 +449,7 @@ where
             self.flush::<R, K, N>(tile, run, oc);
         };
         self.set_coef::<R, K>(r, s[0], coef);
-        tile.add::<K, N>(&s, &factors::<T, D, K, N>(&r.s), &coef[..self.na]);
+        tile.add::<K, N>(&s, &factors::<T, D, K, N>(r.s), &coef[..self.na]);
         run.idx[run.n] = i;
         run.tau[run.n] = tau_dev;
         run.n += 1;
@@ -434,10 +470,11 @@ where
         if !tile.add_to_grid::<K>(outs) {
             for m in 0..run.n {
                 // `pre` and `ready` succeeded for this particle before, with these inputs.
-                let r = self
-                    .pre(run.idx[m])
-                    .and_then(|pre| self.ready(&pre, run.tau[m]))
-                    .and_then(|r| self.scatter::<R, K, N>(&r, oc));
+                let r = self.pre(run.idx[m]).and_then(|pre| {
+                    let s = self.stencil(&pre.p.x)?;
+                    let r = self.ready(&pre, run.tau[m], &s)?;
+                    self.scatter::<R, K, N>(&r, oc)
+                });
                 self.first.note(run.idx[m], r);
             }
         }
@@ -451,12 +488,25 @@ where
         i: usize,
         pre: &Pre<T, D>,
         tau_dev: Mat<T, D>,
+        lane_stencil: Option<&Stencil<T, D>>,
         tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) {
-        let r = match self.ready(pre, tau_dev) {
+        // The stencil from the lanes, or the particle's own (which reports its error).
+        let own;
+        let s = match lane_stencil {
+            Some(s) => s,
+            None => match self.stencil(&pre.p.x) {
+                Ok(s) => {
+                    own = s;
+                    &own
+                }
+                Err(e) => return self.first.note(i, Err(e)),
+            },
+        };
+        let r = match self.ready(pre, tau_dev, s) {
             Err(e) => Err(e),
             Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc, coef),
         };
@@ -503,17 +553,26 @@ where
             tau: [Mat::ZERO; MAX_RUN],
         };
         let lanes = V::LANES;
+        // The chunk's scalar passes, built in place (see `pre_into`); `live[l]` when lane
+        // `l`'s succeeded.
+        let mut pres = [Pre::<T, D>::blank(); MAX_LANES];
+        let mut live = [false; MAX_LANES];
+        // The chunk's positions and stencils (on lanes, see `Stencil::new_lanes`).
+        let (kernel, grid, h) = (self.args.kernel, self.args.grid, self.args.h);
+        let mut xs = [[T::ZERO; D]; MAX_LANES];
+        let mut stencils = [Stencil::blank(kernel, h); MAX_LANES];
         let mut start = 0;
         while start < self.n {
             let len = lanes.min(self.n - start);
-            let mut pre: [Option<Pre<T, D>>; MAX_LANES] = [None; MAX_LANES];
             let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
             let mut mubuf = [T::ZERO; MAX_LANES];
             let mut any_mu = false;
             for l in 0..len {
                 // SAFETY: `p2g`'s contract: the arrays hold `n` particles.
-                match unsafe { self.pre(start + l) } {
-                    Ok(pr) => {
+                live[l] = false;
+                match unsafe { self.pre_into(start + l, &mut pres[l]) } {
+                    Ok(()) => {
+                        let pr = &pres[l];
                         for j in 0..D {
                             for r in 0..D {
                                 fbuf[r + D * j][l] = pr.p.f_e.cols[j][r];
@@ -521,7 +580,7 @@ where
                         }
                         mubuf[l] = pr.mu;
                         any_mu |= pr.mu > T::ZERO;
-                        pre[l] = Some(pr);
+                        live[l] = true;
                     }
                     Err(e) => self.first.note(start + l, Err(e)),
                 }
@@ -531,6 +590,10 @@ where
                     fbuf[d * (D + 1)][l] = T::ONE;
                 }
             }
+            for (x, pr) in xs.iter_mut().zip(&pres).take(len) {
+                *x = pr.p.x;
+            }
+            let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils);
             let mut tbuf = [[T::ZERO; MAX_LANES]; 9];
             let mut lane_err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
             if any_mu {
@@ -557,7 +620,7 @@ where
                 }
             }
             for l in 0..len {
-                if let Some(pr) = pre[l] {
+                if live[l] {
                     if let Some(e) = lane_err[l] {
                         self.first.note(start + l, Err(e));
                         continue;
@@ -572,8 +635,9 @@ where
                     unsafe {
                         self.finish::<R, K, N>(
                             start + l,
-                            &pr,
+                            &pres[l],
                             tau,
+                            (done >> l & 1 == 1).then_some(&stencils[l]),
                             &mut tile,
                             &mut run,
                             &oc,
