@@ -19,7 +19,7 @@
 //! below it. So liquid water at 300 K has `U = L`, ice at 250 K has `U = 0`.
 
 use super::stencil::Stencil;
-use super::{Heat, Phase};
+use super::{Heat, Material, Phase};
 use crate::error::{Error, Result};
 use crate::scalar::Real;
 
@@ -85,6 +85,63 @@ pub fn gather<T: Real, const D: usize>(
 #[must_use]
 pub fn blend<T: Real>(flip: T, t_p: T, t_pic: T, dt_flip: T) -> T {
     (T::ONE - flip) * t_pic + flip * (t_p + dt_flip)
+}
+
+/// Step 1 of the particle update ([`super::update::update_particle`]): the new thermal state
+/// of a particle in state `st` from its G2P sums `(t_pic, t_flip)` ([`gather`]) under `heat`.
+/// `T*` is the [`blend`]; without phase change the particle takes `T*`; with it, the heat
+/// `q = c (T* − T_p)` (J/kg, `c` of the particle's current phase) goes through [`absorb`],
+/// whose split is returned (zero without phase change).
+///
+/// Errors: [`Error::NonFinite`] for a NaN/inf sum; [`Error::Overflow`] for a `T*` or `q` that
+/// is not finite; those of [`absorb`].
+#[inline(always)]
+pub(crate) fn step<T: Real>(
+    material: &Material<T>,
+    heat: &Heat<T>,
+    st: &ThermalState<T>,
+    t_pic: T,
+    t_flip: T,
+) -> Result<(ThermalState<T>, HeatSplit<T>)> {
+    if !(t_pic.is_finite() && t_flip.is_finite()) {
+        return Err(Error::NonFinite);
+    }
+    let t_star = blend(heat.flip, st.temperature, t_pic, t_flip);
+    if !t_star.is_finite() {
+        return Err(Error::Overflow);
+    }
+    if !heat.phase_change {
+        let new = ThermalState {
+            temperature: t_star,
+            ..*st
+        };
+        return Ok((new, HeatSplit::default()));
+    }
+    let c = material.params(st.phase).heat_capacity;
+    let q = c * (t_star - st.temperature);
+    if !q.is_finite() {
+        return Err(Error::Overflow);
+    }
+    absorb(
+        heat,
+        material.solid.heat_capacity,
+        material.liquid.heat_capacity,
+        st,
+        q,
+    )
+}
+
+/// Checks a new thermal state as the next call checks it: a finite temperature
+/// ([`Error::Overflow`] otherwise, a result), and with phase change [`check_state`].
+#[inline(always)]
+pub(crate) fn check_result<T: Real>(heat: &Heat<T>, st: &ThermalState<T>) -> Result<()> {
+    if !st.temperature.is_finite() {
+        return Err(Error::Overflow);
+    }
+    if heat.phase_change {
+        check_state(heat, st)?;
+    }
+    Ok(())
 }
 
 /// Checks the invariants of the module docs.

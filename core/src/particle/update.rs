@@ -463,38 +463,16 @@ where
 
     // 1. Heat and phase.
     if let Some(heat) = &material.heat {
-        if !(s.t_pic.is_finite() && s.t_flip.is_finite()) {
-            return Err(Error::NonFinite);
-        }
-        let t_star = thermal::blend(heat.flip, p.temperature, s.t_pic, s.t_flip);
-        if !t_star.is_finite() {
-            return Err(Error::Overflow);
-        }
-        if heat.phase_change {
-            let c = material.params(p.phase).heat_capacity;
-            let q = c * (t_star - p.temperature);
-            if !q.is_finite() {
-                return Err(Error::Overflow);
-            }
-            let st = ThermalState {
-                temperature: p.temperature,
-                latent: p.latent,
-                phase: p.phase,
-            };
-            let (st, split) = thermal::absorb(
-                heat,
-                material.solid.heat_capacity,
-                material.liquid.heat_capacity,
-                &st,
-                q,
-            )?;
-            out.temperature = st.temperature;
-            out.latent = st.latent;
-            out.phase = st.phase;
-            info.heat = split;
-        } else {
-            out.temperature = t_star;
-        }
+        let st = ThermalState {
+            temperature: p.temperature,
+            latent: p.latent,
+            phase: p.phase,
+        };
+        let (st, split) = thermal::step(material, heat, &st, s.t_pic, s.t_flip)?;
+        out.temperature = st.temperature;
+        out.latent = st.latent;
+        out.phase = st.phase;
+        info.heat = split;
     }
 
     // 2. APIC velocity, affine matrix and advection.
@@ -564,19 +542,12 @@ where
         Err(e) => return Err(e),
     };
     if let Some(heat) = &material.heat {
-        if !p.temperature.is_finite() {
-            return Err(Error::Overflow);
-        }
-        if heat.phase_change {
-            thermal::check_state(
-                heat,
-                &ThermalState {
-                    temperature: p.temperature,
-                    latent: p.latent,
-                    phase: p.phase,
-                },
-            )?;
-        }
+        let st = ThermalState {
+            temperature: p.temperature,
+            latent: p.latent,
+            phase: p.phase,
+        };
+        thermal::check_result(heat, &st)?;
     }
     material.moduli(p.phase, j_p)?;
     Ok(())
