@@ -1,10 +1,13 @@
-//! G2P: reference match, batch chunks against single particles, linear fields, nodes read.
+//! G2P: reference match, batch chunks (with and without heat) against single particles, linear
+//! fields, nodes read.
 use crate::{deformation, materials, particles, rand_mat, DenseGrid, Store, HC, LATENT, MOM, TM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::lane::Isa;
 use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
 use ampm_core::particle::transfer::Particles;
-use ampm_core::particle::{g2p_update, Grid, GridSample, Kernel, Phase, Stencil};
+use ampm_core::particle::{
+    g2p_update, Grid, GridSample, Heat, Kernel, Material, Particle, Phase, Stencil,
+};
 use ampm_core::polar::{DefaultSvd, SvdMethod};
 use ampm_core::{Error, Mat, Matrix, Real};
 use ampm_tools::workload::HaarRotation;
@@ -149,10 +152,11 @@ where
 /// G2P of a whole batch gives the bits of calls of one particle each, on every instruction set
 /// and material, for solid and for liquid batches: the batch updates chunks of elastic solids
 /// and of liquids on SIMD lanes, a call of one particle updates it alone (the scalar update).
-/// The batch mixes chunks that stay on lanes with chunks that must fall back: a particle with a
-/// NaN `F_P`, one whose `F_E` is inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a
-/// strongly compressive node velocity), a particle of the other phase, and one whose `F_E` has
-/// a subnormal column (the liquid projection's scalings leave the normal range). Liquid batches
+/// The batch mixes chunks that stay on lanes (one with a particle of the other phase among
+/// them) with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
+/// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node
+/// velocity), and one whose `F_E` has a subnormal column (the liquid projection's scalings
+/// leave the normal range). Liquid batches
 /// also have isotropic and general `F_P` and an `F_E` with columns of very different scales
 /// (the projection's root on equilibrated columns), in chunks that stay on lanes.
 fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
@@ -169,10 +173,6 @@ where
             .into_iter()
             .flat_map(|m| [(m.clone(), false), (m, true)])
         {
-            if liquid && mat.heat.is_some() {
-                // Heat is updated per particle: nothing on lanes to compare.
-                continue;
-            }
             let mut rng = Pcg64::seed_from_u64(11);
             let mut ps = particles::<T, D>(&mut rng, 75, hf, cells, &mat);
             let (this, other) = if liquid {
@@ -218,60 +218,165 @@ where
                 h,
                 dt,
             };
-            let mut batch = Store::from(&ps);
-            let raw = batch.raw();
-            // SAFETY: the arrays hold the particles; the grid covers their stencils.
-            let st =
-                unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
-            let mut one = Store::from(&ps);
-            let mut first = None;
-            for i in 0..ps.len() {
-                let r = one.raw();
-                // SAFETY: particle `i` of the arrays, as one particle.
-                let st1 = unsafe {
-                    let at = Particles {
-                        x: r.x.add(D * i),
-                        v: r.v.add(D * i),
-                        affine: r.affine.add(D * D * i),
-                        f_e: r.f_e.add(D * D * i),
-                        f_p: r.f_p.add(D * D * i),
-                        mass: r.mass.add(i),
-                        volume0: r.volume0.add(i),
-                        temperature: r.temperature.add(i),
-                        latent: r.latent.add(i),
-                        phase: r.phase.add(i),
-                    };
-                    g2p::g2p_update(isa, &mat, &args, 1, &at, &g.g2p_view(), None)
-                };
-                if let (None, Some(e)) = (first, st1.error) {
-                    first = Some((i, e));
-                }
-            }
-            assert_eq!(
-                first.map(|f| f.0).unwrap_or(ps.len()),
-                st.first_failed,
-                "{name} {liquid} {isa:?}"
-            );
-            assert_eq!(first.map(|f| f.1), st.error, "{name} {liquid} {isa:?}");
-            assert!(first.is_some(), "{name}: the NaN particle fails");
-            let bits = |s: &Store<T>| -> Vec<u64> {
-                [
-                    &s.x,
-                    &s.v,
-                    &s.affine,
-                    &s.f_e,
-                    &s.f_p,
-                    &s.temperature,
-                    &s.latent,
-                ]
-                .iter()
-                .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
-                .chain(s.phase.iter().map(|&c| u64::from(c)))
-                .collect()
-            };
-            assert_eq!(bits(&batch), bits(&one), "{name} {liquid} {isa:?}");
+            let label = format!("{name} {liquid} {isa:?}");
+            let first = batch_matches_single(isa, &mat, &args, &ps, &g, &label);
+            assert!(first.is_some(), "{label}: the NaN particle fails");
         }
     }
+}
+
+/// Runs G2P over `ps` on `isa` as one batch and particle by particle (calls of one particle:
+/// the scalar update), asserts the same first failure, status and bits of every particle
+/// array, and returns the first failure.
+fn batch_matches_single<T: BatchReal, const D: usize>(
+    isa: Isa,
+    mat: &Material<T>,
+    args: &G2pArgs<T>,
+    ps: &[Particle<T, D>],
+    g: &DenseGrid<T, D>,
+    label: &str,
+) -> Option<(usize, Error)>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let mut batch = Store::from(ps);
+    let raw = batch.raw();
+    // SAFETY: the arrays hold the particles; the grid covers their stencils.
+    let st = unsafe { g2p::g2p_update(isa, mat, args, ps.len(), &raw, &g.g2p_view(), None) };
+    let mut one = Store::from(ps);
+    let mut first = None;
+    for i in 0..ps.len() {
+        let r = one.raw();
+        // SAFETY: particle `i` of the arrays, as one particle.
+        let st1 = unsafe {
+            let at = Particles {
+                x: r.x.add(D * i),
+                v: r.v.add(D * i),
+                affine: r.affine.add(D * D * i),
+                f_e: r.f_e.add(D * D * i),
+                f_p: r.f_p.add(D * D * i),
+                mass: r.mass.add(i),
+                volume0: r.volume0.add(i),
+                temperature: r.temperature.add(i),
+                latent: r.latent.add(i),
+                phase: r.phase.add(i),
+            };
+            g2p::g2p_update(isa, mat, args, 1, &at, &g.g2p_view(), None)
+        };
+        if let (None, Some(e)) = (first, st1.error) {
+            first = Some((i, e));
+        }
+    }
+    assert_eq!(
+        first.map(|f| f.0).unwrap_or(ps.len()),
+        st.first_failed,
+        "{label}"
+    );
+    assert_eq!(first.map(|f| f.1), st.error, "{label}");
+    let bits = |s: &Store<T>| -> Vec<u64> {
+        [
+            &s.x,
+            &s.v,
+            &s.affine,
+            &s.f_e,
+            &s.f_p,
+            &s.temperature,
+            &s.latent,
+        ]
+        .iter()
+        .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
+        .chain(s.phase.iter().map(|&c| u64::from(c)))
+        .collect()
+    };
+    assert_eq!(bits(&batch), bits(&one), "{label}");
+    first
+}
+
+/// With heat, G2P's batch equals calls of one particle, bit for bit and status for status: the
+/// batch updates a chunk on SIMD lanes after each particle's heat step (the scalar one, per
+/// lane), solids and liquids alike. Chunks of 8 (the grid warms every particle by about 3 K):
+/// solids below the melting point; liquids; solids at it filling their latent buffer; solids
+/// that melt in this step (projected at once); solids of which half melt (solids and liquids
+/// in one chunk); a NaN temperature; an invalid thermal state (a liquid below the melting
+/// point); liquids with general `F_P`; a partial chunk. With and without phase change.
+fn g2p_heat_chunks_match_single<T: BatchReal, const D: usize>()
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let args = G2pArgs {
+        kernel: Kernel::Quadratic,
+        h: T::from_f64(hf),
+        dt: T::from_f64(1e-3),
+    };
+    let (_, thermal) = materials::<T>()
+        .into_iter()
+        .find(|(n, _)| *n == "thermal")
+        .unwrap();
+    let heat = thermal.heat.unwrap();
+    let no_change = Material {
+        heat: Some(Heat {
+            phase_change: false,
+            ..heat
+        }),
+        ..thermal.clone()
+    };
+    let mut g = g2p_grid::<T, D>(cells, 5);
+    let mut rg = Pcg64::seed_from_u64(6);
+    for k in 0..g.ch[HC].len() {
+        g.ch[HC][k] = T::from_f64(TM + 3.0 + rg.random_range(0.0..1.0));
+        g.ch[HC + 1][k] = T::from_f64(TM + rg.random_range(-0.5..0.5));
+    }
+    for isa in Isa::available() {
+        for (name, mat) in [("phase change", &thermal), ("no phase change", &no_change)] {
+            let mut rng = Pcg64::seed_from_u64(12);
+            let mut ps = particles::<T, D>(&mut rng, 83, hf, cells, mat);
+            let c = T::from_f64;
+            for (i, p) in ps.iter_mut().enumerate() {
+                let (chunk, lane) = (i / 8, i % 8);
+                let liquid = matches!(chunk, 1 | 6 | 9);
+                let state = match chunk {
+                    _ if liquid => (TM + rng.random_range(0.5..20.0), LATENT),
+                    2 => (TM, rng.random_range(0.0..0.5 * LATENT)),
+                    3 => (TM, LATENT - rng.random_range(0.0..100.0)),
+                    4 if lane % 2 == 0 => (TM, LATENT - rng.random_range(0.0..100.0)),
+                    4 => (TM, rng.random_range(0.0..0.5 * LATENT)),
+                    _ => (TM - rng.random_range(10.0..20.0), 0.0),
+                };
+                p.temperature = c(state.0);
+                p.latent = c(state.1);
+                p.phase = if liquid { Phase::Liquid } else { Phase::Solid };
+                p.f_p = if liquid && chunk == 9 {
+                    deformation::<D>(&mut rng, 0.8, 1.25).cast()
+                } else if liquid {
+                    Mat::identity() * c(rng.random_range(0.9..1.1))
+                } else {
+                    Mat::identity()
+                };
+            }
+            ps[5 * 8 + 3].temperature = c(f64::NAN);
+            ps[6 * 8 + 5].temperature = c(TM - 1.0);
+            let label = format!("{name} {isa:?}");
+            let first = batch_matches_single(isa, mat, &args, &ps, &g, &label);
+            assert_eq!(first, Some((43, Error::NonFinite)), "{label}");
+        }
+    }
+}
+
+#[test]
+fn g2p_heat_chunks_match_single_2d_f32() {
+    g2p_heat_chunks_match_single::<f32, 2>();
+}
+#[test]
+fn g2p_heat_chunks_match_single_3d_f32() {
+    g2p_heat_chunks_match_single::<f32, 3>();
+}
+#[test]
+fn g2p_heat_chunks_match_single_3d_f64() {
+    g2p_heat_chunks_match_single::<f64, 3>();
 }
 
 #[test]

@@ -156,8 +156,9 @@ where
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
-        // Chunks of elastic solids or of liquids are updated on the row type's eight lanes.
-        let lanes = update_lanes::on_lanes(self.material) && R::LANES == CHUNK;
+        // Chunks of elastic solids or of liquids (after their heat step) are updated on the row
+        // type's eight lanes.
+        let lanes = R::LANES == CHUNK;
         let mut cs = ChunkSamples::new();
         // The chunk's samples and their statuses, written in place: a sample returned by value
         // (in a `Result`) is copied with wide moves right after its fields were stored one by
@@ -221,7 +222,7 @@ where
                     all_ok = false;
                 }
             }
-            // SAFETY: as above; `on_lanes(material)` when `lanes`.
+            // SAFETY: as above.
             if lanes
                 && len == CHUNK
                 && all_ok

@@ -1,6 +1,6 @@
-//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane), for
-//! materials without heat, when every particle of the chunk is either a solid without
-//! plasticity (the plain elastic update) or a liquid.
+//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane), when
+//! every particle of the chunk is, after its heat step, either a solid without plasticity (the
+//! plain elastic update) or a liquid (solids and liquids may share a chunk).
 //!
 //! The update is that of [`crate::particle::update::update_particle`] for these particles
 //! (Stomakhin et al. 2014, §5: APIC velocity and affine matrix, `x ← x + Δt v`,
@@ -8,22 +8,25 @@
 //! [`liquid_projection`]), with the same operations in the same order (separate
 //! multiplications and additions, no fused multiply-add, the matrix products and determinants of
 //! [`crate::mat::Mat`], the power-of-two scalings and roots of [`root_det`]), so every lane gets
-//! the bits of the scalar update. Every check of the scalar path is made on all lanes (the
-//! input particle as [`check_particle`] checks it, the new position, `det(I + Δt∇v) > 0`, the
-//! new `F_E` and `F_P` and their determinants, the position limit); if any lane fails one, needs
-//! the remedy for `det(I + Δt∇v) ≤ 0`, or lies where [`root_det`]'s scalings leave the normal
-//! range, nothing is written and the caller updates the chunk's particles one by one, which
-//! gives each its exact status.
+//! the bits of the scalar update. With heat, the heat step (temperature, latent buffer, phase)
+//! is the scalar one ([`thermal::step`]) per lane. Every check of the scalar path is made on
+//! all lanes (the input particle as [`check_particle`] checks it, the new position,
+//! `det(I + Δt∇v) > 0`, the new `F_E` and `F_P` and their determinants, the position limit);
+//! if any lane fails one, needs the remedy for `det(I + Δt∇v) ≤ 0`, or lies where
+//! [`root_det`]'s scalings leave the normal range, nothing is written and the caller
+//! updates the chunk's particles one by one, which gives each its exact status.
 //!
 //! [`check_particle`]: crate::particle::update::check_particle
+//! [`thermal::step`]: crate::particle::thermal::step
 //! [`liquid_projection`]: crate::particle::deformation::liquid_projection
 //! [`root_det`]: crate::particle::deformation::root_det
 
-use super::{Checked, Particles};
+use super::{rd, wr, Checked, Particles};
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
+use crate::particle::thermal::{self, ThermalState};
 use crate::particle::update::G2pSample;
-use crate::particle::{Material, Phase};
+use crate::particle::{Heat, Material, Phase};
 use crate::scalar::Real;
 
 /// Particles per chunk: the eight lanes of the row types.
@@ -38,6 +41,8 @@ pub(super) struct ChunkSamples<T> {
     v: [[T; LANES]; MAX_D],
     affine: [[T; LANES]; MAX_D * MAX_D],
     grad_v: [[T; LANES]; MAX_D * MAX_D],
+    t_pic: [T; LANES],
+    t_flip: [T; LANES],
 }
 
 impl<T: Real> ChunkSamples<T> {
@@ -48,6 +53,8 @@ impl<T: Real> ChunkSamples<T> {
             v: [[T::ZERO; LANES]; MAX_D],
             affine: [[T::ZERO; LANES]; MAX_D * MAX_D],
             grad_v: [[T::ZERO; LANES]; MAX_D * MAX_D],
+            t_pic: [T::ZERO; LANES],
+            t_flip: [T::ZERO; LANES],
         }
     }
 
@@ -63,14 +70,9 @@ impl<T: Real> ChunkSamples<T> {
                 self.grad_v[i + D * j][l] = s.grad_v.cols[j][i];
             }
         }
+        self.t_pic[l] = s.t_pic;
+        self.t_flip[l] = s.t_flip;
     }
-}
-
-/// Whether [`update`] can run a material's chunks: no heat (a chunk must then also be all solid
-/// without plasticity, or all liquid; [`update`] checks that).
-#[inline(always)]
-pub(super) fn on_lanes<T: Real>(material: &Material<T>) -> bool {
-    material.heat.is_none()
 }
 
 /// A `D × D` matrix of lanes from particle matrices at `p` (`d²` scalars per particle,
@@ -134,20 +136,77 @@ fn product<V: Lane, const D: usize>(a: &LMat<V, D>, b: &LMat<V, D>) -> LMat<V, D
     m
 }
 
-/// The phase of every particle of the chunk at `start` (solid when `phase` is null), or `None`
-/// for a chunk of mixed (or invalid) phases.
+/// The phase of each particle of the chunk at `start` (solid when `phase` is null), or `None`
+/// if a code is invalid or the material is not valid for a lane's phase (`checked`).
 ///
 /// # Safety
 /// `phase` is null or holds the chunk's particles.
 #[inline(always)]
-unsafe fn chunk_phase(phase: *const u8, start: usize) -> Option<Phase> {
-    if phase.is_null() {
-        return Some(Phase::Solid);
+unsafe fn chunk_phases(
+    phase: *const u8,
+    start: usize,
+    checked: &Checked,
+) -> Option<[Phase; LANES]> {
+    let mut out = [Phase::Solid; LANES];
+    for (l, p) in out.iter_mut().enumerate() {
+        if !phase.is_null() {
+            *p = Phase::from_code(rd(phase, start + l)).ok()?;
+        }
+        checked.for_phase(*p).ok()?;
     }
-    let ph = core::slice::from_raw_parts(phase.add(start), LANES);
-    [Phase::Solid, Phase::Liquid]
-        .into_iter()
-        .find(|&p| ph.iter().all(|&c| c == p as u8))
+    Some(out)
+}
+
+/// The heat step of the chunk at `start`, per lane as the scalar update makes it: the input
+/// phase (solid when `phase` is null) valid for the material (`checked`), a finite input
+/// temperature, then [`thermal::step`] and [`thermal::check_result`] of the new state, written
+/// to `out`. Returns whether every lane passed (else the caller updates the chunk particle by
+/// particle).
+///
+/// # Safety
+/// The temperature array (and with phase change the latent array) holds the chunk's
+/// particles; `phase` is null or holds them.
+#[inline(always)]
+unsafe fn heat_chunk<T: Real>(
+    material: &Material<T>,
+    checked: &Checked,
+    ps: &Particles<T>,
+    start: usize,
+    cs: &ChunkSamples<T>,
+    heat: &Heat<T>,
+    out: &mut [ThermalState<T>; LANES],
+) -> bool {
+    for (l, new) in out.iter_mut().enumerate() {
+        let i = start + l;
+        let phase = if ps.phase.is_null() {
+            Phase::Solid
+        } else {
+            match Phase::from_code(rd(ps.phase, i)) {
+                Ok(p) => p,
+                Err(_) => return false,
+            }
+        };
+        if checked.for_phase(phase).is_err() {
+            return false;
+        }
+        let st = ThermalState {
+            temperature: rd(ps.temperature, i),
+            latent: if heat.phase_change {
+                rd(ps.latent, i)
+            } else {
+                T::ZERO
+            },
+            phase,
+        };
+        if !st.temperature.is_finite() {
+            return false;
+        }
+        match thermal::step(material, heat, &st, cs.t_pic[l], cs.t_flip[l]) {
+            Ok((st, _)) if thermal::check_result(heat, &st).is_ok() => *new = st,
+            _ => return false,
+        }
+    }
+    true
 }
 
 /// `(det M)^{1/d}` per lane with the bits of [`root_det`] (column equilibration by powers of
@@ -201,6 +260,18 @@ fn root_det<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> (V,
     // |q| ≤ bias − 1 by the column bounds: one multiplication, as `scalbn`.
     let r = root * V::pow2(q);
     (r, ok & r.is_finite() & zero.lt(r))
+}
+
+/// `a` on the lanes of `m`, `b` on the others.
+#[inline(always)]
+fn select_mat<V: Lane, const D: usize>(m: V::Mask, a: &LMat<V, D>, b: &LMat<V, D>) -> LMat<V, D> {
+    let mut r = *b;
+    for (cr, ca) in r.iter_mut().zip(a.iter()) {
+        for (x, y) in cr.iter_mut().zip(ca.iter()) {
+            *x = V::select(m, *y, *x);
+        }
+    }
+    r
 }
 
 /// `s I`.
@@ -264,12 +335,13 @@ fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
 
 /// Updates particles `start..start + LANES` from their transposed samples `cs` (each sample
 /// was computed without error) with step `dt` on a collocated grid of spacing `h`, if the chunk
-/// is all solid (material without plasticity) or all liquid and every lane passes every check
-/// of the scalar update (see the module docs); returns whether it did. Writes
-/// `x, v, affine, f_e`, and `f_p` where a liquid's changes.
+/// holds only solids (material without plasticity) and liquids after the heat step and every
+/// lane passes every check of the scalar update (see the module docs); returns whether it did.
+/// Writes `x, v, affine, f_e`, `f_p` where a liquid's changes, and with heat the temperature
+/// (with phase change also the latent buffer and the phase).
 ///
 /// # Safety
-/// The arrays of `ps` hold the chunk's particles; `on_lanes(material)`.
+/// The arrays of `ps` that the update reads and writes hold the chunk's particles.
 #[inline(always)]
 pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     material: &Material<T>,
@@ -280,19 +352,39 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     start: usize,
     cs: &ChunkSamples<T>,
 ) -> bool {
-    debug_assert!(V::LANES == LANES && on_lanes(material) && D <= MAX_D);
+    debug_assert!(V::LANES == LANES && D <= MAX_D);
     let inv_h = T::ONE / h;
     if !(dt.is_finite() && dt > T::ZERO && h.is_finite() && h > T::ZERO) || !inv_h.is_finite() {
         return false;
     }
-    let phase = match chunk_phase(ps.phase, start) {
-        Some(Phase::Solid) if material.plasticity.is_none() => Phase::Solid,
-        Some(Phase::Liquid) => Phase::Liquid,
-        _ => return false,
+    let mut heat_new = [ThermalState {
+        temperature: T::ZERO,
+        latent: T::ZERO,
+        phase: Phase::Solid,
+    }; LANES];
+    // The phase of each lane after its heat step (the phase of the update's step 4).
+    let phases = match &material.heat {
+        None => match chunk_phases(ps.phase, start, checked) {
+            Some(p) => p,
+            None => return false,
+        },
+        Some(heat) => {
+            if !heat_chunk(material, checked, ps, start, cs, heat, &mut heat_new) {
+                return false;
+            }
+            heat_new.map(|st| st.phase)
+        }
     };
-    if checked.for_phase(phase).is_err() {
-        return false;
+    // Liquid lanes, and solids only without plasticity.
+    let mut liquid_flags = [T::ZERO; LANES];
+    for (fl, p) in liquid_flags.iter_mut().zip(&phases) {
+        match p {
+            Phase::Liquid => *fl = T::ONE,
+            Phase::Solid if material.plasticity.is_some() => return false,
+            Phase::Solid => {}
+        }
     }
+    let any_liquid = phases.contains(&Phase::Liquid);
     // The input particles, as `check_particle` checks them: v and the affine matrix are only
     // checked (they are replaced), and checked where they lie.
     if !(finite_run::<T, V>(ps.v.add(D * start), D * LANES)
@@ -349,11 +441,16 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     // F_E ← A F_E, finite with a finite positive determinant (`check_det`).
     let f = product(&inc, &f_e);
     ok = ok & det_ok(&f);
-    // A liquid keeps its volume ratios only; a solid (no plasticity) keeps `F_P`.
-    let (f, f_p_new) = if phase == Phase::Liquid {
+    // A liquid keeps its volume ratios only; a solid (no plasticity) keeps `F_P`. In a chunk
+    // of both, every lane computes both and takes its own (the other's checks do not apply).
+    let (f, f_p_new) = if any_liquid {
+        let liq = zero.lt(V::load(&liquid_flags));
         let (fe, fp, proj_ok) = liquid(&f, &f_p);
-        ok = ok & proj_ok;
-        (fe, fp)
+        ok = ok & (proj_ok | !liq);
+        (
+            select_mat(liq, &fe, &f),
+            fp.map(|fp| select_mat(liq, &fp, &f_p)),
+        )
     } else {
         (f, None)
     };
@@ -361,6 +458,15 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
         return false;
     }
 
+    if let Some(heat) = &material.heat {
+        for (l, st) in heat_new.iter().enumerate() {
+            wr(ps.temperature, start + l, st.temperature);
+            if heat.phase_change {
+                wr(ps.latent, start + l, st.latent);
+                wr(ps.phase, start + l, st.phase as u8);
+            }
+        }
+    }
     let all = (1u32 << LANES) - 1;
     for a in 0..D {
         xn[a].scatter(ps.x.add(D * start + a), D, all);
