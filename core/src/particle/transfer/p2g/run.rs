@@ -1,0 +1,369 @@
+//! P2G's node loops: the chunked particle loop (stresses and stencils on SIMD lanes), the node
+//! tile of a run of nearby particles (`transfer/tile.rs`) and its flush into the grid, and the
+//! one-particle scatter that a run whose sums overflow falls back to.
+
+use super::{P2gOp, Pre, Ready, Run};
+use crate::error::{Error, Result};
+use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, MAX_LANES};
+use crate::kernel::chunk::check_bits;
+use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
+use crate::lane::lmat::{mul_nt, LMat};
+use crate::lane::Lane;
+use crate::mat::{Mat, Matrix};
+use crate::particle::stencil::Stencil;
+use crate::particle::transfer::nodes::{
+    add, node_offsets, nodes, rel_base, restore, table, with_nodes,
+};
+use crate::particle::transfer::tile::{
+    axis0, factors, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X,
+};
+use crate::particle::transfer::BatchStatus;
+use core::mem::MaybeUninit;
+
+impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    /// Scatter-adds one particle (`K` nodes per axis, `N = K^d`; `oc` from [`node_offsets`]).
+    /// The node values of each channel are formed as an array over the nodes, then added;
+    /// every old value is kept, and if a new one is not finite the old values are put back
+    /// (in reverse order, so that aliased channels are restored too) and the particle fails.
+    #[inline(always)]
+    unsafe fn scatter<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        r: &Ready<'_, T, D>,
+        oc: &[[T; N]; D],
+    ) -> Result<()> {
+        let rel = rel_base(r.s, &self.view.nodes)?;
+        let comps = self.comps();
+        let act = self.outs[..self.na].iter().zip(&self.kinds[..self.na]);
+        let nd = nodes::<T, D, K, N>(r.s);
+        let idt = self.args.impulse_dt;
+        // The force on the nodes along axis `a`.
+        // The node forces along the written axes, once for the momentum and force channels.
+        let mut force = [[T::ZERO; N]; D];
+        for (a, f) in force.iter_mut().enumerate() {
+            if a < comps.0 || a >= comps.1 {
+                continue;
+            }
+            for i in 0..N {
+                for b in 0..D {
+                    f[i] += r.fm.cols[b][a] * nd.g[b][i];
+                }
+            }
+        }
+        let mut old = [[MaybeUninit::<T>::uninit(); N]; MAX_CH];
+        let mut ok = true;
+        for (j, (ch, &kind)) in act.enumerate() {
+            let t = table(ch, &rel);
+            let mut val = [T::ZERO; N];
+            match kind {
+                0 => {
+                    for i in 0..N {
+                        val[i] = nd.w[i] * r.mass;
+                    }
+                }
+                1..=3 => {
+                    let a = kind - 1;
+                    let f = &force[a];
+                    for i in 0..N {
+                        let mut q = r.q0[a];
+                        for b in 0..D {
+                            q += r.mch.cols[b][a] * oc[b][i];
+                        }
+                        val[i] = nd.w[i] * q + idt * f[i];
+                    }
+                }
+                4..=6 => val = force[kind - 4],
+                k => {
+                    for i in 0..N {
+                        val[i] = nd.w[i] * r.heat[k - 7];
+                    }
+                }
+            }
+            ok &= add::<T, R, D, K, N>(ch.data, &t, ch.stride[0], &val, &mut old[j]);
+        }
+        if ok {
+            return Ok(());
+        }
+        for (j, ch) in self.outs[..self.na].iter().enumerate().rev() {
+            let t = table(ch, &rel);
+            restore::<T, D, K, N>(ch.data, &t, ch.stride[0], &old[j]);
+        }
+        Err(Error::Overflow)
+    }
+
+    /// Sets the tile lane vectors of a particle's node values per active channel (see
+    /// [`super::tile`]), for lane offset `s0` along axis 0, into `out` (the other entries are
+    /// left as they are).
+    #[inline(always)]
+    fn set_coef<R: Lane<Scalar = T>, const K: usize>(
+        &self,
+        r: &Ready<'_, T, D>,
+        s0: usize,
+        out: &mut [Coef<R, D>; MAX_CH],
+    ) {
+        let sp = R::splat;
+        let (w, dw) = axis0::<T, R, D, K>(r.s, s0);
+        // The axis-0 node offsets o₀ of the lanes (exact small integers).
+        let mut lane = [T::ZERO; TILE_X];
+        for (l, x) in lane.iter_mut().enumerate() {
+            *x = T::from_i32(l as i32 - s0 as i32);
+        }
+        let o0 = R::load(&lane);
+        let idt = self.args.impulse_dt;
+        for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
+            match kind {
+                0 => *c = Coef::only(w * sp(r.mass)),
+                k @ 1..=3 => {
+                    // w (q₀ + (mCh) o) + Δt_f f.
+                    let a = k - 1;
+                    let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
+                    if idt == T::ZERO {
+                        c.p = w * q;
+                        c.has_b = false;
+                    } else {
+                        set_grad(c, w, dw, &r.fm, a, idt);
+                        c.p = w.mul_add(q, c.p);
+                    }
+                    for b in 1..D {
+                        c.e[b] = w * sp(r.mch.cols[b][a]);
+                    }
+                    c.has_e = true;
+                }
+                k @ 4..=6 => set_grad(c, w, dw, &r.fm, k - 4, T::ONE),
+                k => *c = Coef::only(w * sp(r.heat[k - 7])),
+            }
+        }
+    }
+
+    /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
+    /// particle does not fit in its tile or the run is full.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        i: usize,
+        r: &Ready<'_, T, D>,
+        tau_dev: Mat<T, D>,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
+        oc: &[[T; N]; D],
+        coef: &mut [Coef<R, D>; MAX_CH],
+    ) -> Result<()> {
+        let rel = rel_base(r.s, &self.view.nodes)?;
+        if run.n == MAX_RUN {
+            self.flush::<R, K, N>(tile, run, oc);
+        }
+        let s = loop {
+            if let Some(s) = tile.place::<K>(&rel, &r.s.fx) {
+                break s;
+            }
+            // An empty tile takes any stencil.
+            self.flush::<R, K, N>(tile, run, oc);
+        };
+        self.set_coef::<R, K>(r, s[0], coef);
+        tile.add::<K, N>(&s, &factors::<T, D, K, N>(r.s), &coef[..self.na]);
+        run.idx[run.n] = i;
+        run.tau[run.n] = tau_dev;
+        run.n += 1;
+        Ok(())
+    }
+
+    /// Adds the tile to the grid and empties it; if a new node value is not finite, the grid
+    /// is left as it was and the run's particles are added one by one ([`Self::scatter`]),
+    /// which refuses the ones that overflow.
+    #[inline(always)]
+    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
+        oc: &[[T; N]; D],
+    ) {
+        let outs = &self.outs[..self.na];
+        if !tile.add_to_grid::<K>(outs) {
+            for m in 0..run.n {
+                // `pre` and `ready` succeeded for this particle before, with these inputs.
+                let r = self.pre(run.idx[m]).and_then(|pre| {
+                    let s = self.stencil(&pre.p.x)?;
+                    let r = self.ready(&pre, run.tau[m], &s)?;
+                    self.scatter::<R, K, N>(&r, oc)
+                });
+                self.first.note(run.idx[m], r);
+            }
+        }
+        run.n = 0;
+    }
+
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        i: usize,
+        pre: &Pre<T, D>,
+        tau_dev: Mat<T, D>,
+        lane_stencil: Option<&Stencil<T, D>>,
+        tile: &mut Tile<R, D>,
+        run: &mut Run<T, D>,
+        oc: &[[T; N]; D],
+        coef: &mut [Coef<R, D>; MAX_CH],
+    ) {
+        // The stencil from the lanes, or the particle's own (which reports its error).
+        let own;
+        let s = match lane_stencil {
+            Some(s) => s,
+            None => match self.stencil(&pre.p.x) {
+                Ok(s) => {
+                    own = s;
+                    &own
+                }
+                Err(e) => return self.first.note(i, Err(e)),
+            },
+        };
+        let r = match self.ready(pre, tau_dev, s) {
+            Err(e) => Err(e),
+            Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc, coef),
+        };
+        self.first.note(i, r);
+    }
+}
+
+impl<T: BatchReal, const D: usize> LaneOp<T> for P2gOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    #[inline(always)]
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // `dispatch` calls `run_rows`; this is its scalar-row form.
+        self.run_rows::<V, ScalarRow<T>>()
+    }
+
+    #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<V, R, K, N>())
+    }
+}
+
+impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    #[inline(always)]
+    fn run_nodes<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+    ) -> BatchStatus {
+        debug_assert_eq!(R::LANES, TILE_X);
+        let oc = node_offsets::<T, D, K, N>();
+        let mut tile = Tile::<R, D>::new();
+        // The tile lane vectors of the particle being added (filled per particle for the
+        // active channels; one buffer, so that no per-particle array is initialised).
+        let mut coef = [Coef::only(R::splat(T::ZERO)); MAX_CH];
+        let mut run = Run {
+            n: 0,
+            idx: [0; MAX_RUN],
+            tau: [Mat::ZERO; MAX_RUN],
+        };
+        let lanes = V::LANES;
+        // The chunk's scalar passes, built in place (see `pre_into`); `live[l]` when lane
+        // `l`'s succeeded.
+        let mut pres = [Pre::<T, D>::blank(); MAX_LANES];
+        let mut live = [false; MAX_LANES];
+        // The chunk's positions and stencils (on lanes, see `Stencil::new_lanes`).
+        let (kernel, grid, h) = (self.args.kernel, self.args.grid, self.args.h);
+        let mut xs = [[T::ZERO; D]; MAX_LANES];
+        let mut stencils = [Stencil::blank(kernel, h); MAX_LANES];
+        let mut start = 0;
+        while start < self.n {
+            let len = lanes.min(self.n - start);
+            let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
+            let mut mubuf = [T::ZERO; MAX_LANES];
+            let mut any_mu = false;
+            for l in 0..len {
+                // SAFETY: `p2g`'s contract: the arrays hold `n` particles.
+                live[l] = false;
+                match unsafe { self.pre_into(start + l, &mut pres[l]) } {
+                    Ok(()) => {
+                        let pr = &pres[l];
+                        for j in 0..D {
+                            for r in 0..D {
+                                fbuf[r + D * j][l] = pr.p.f_e.cols[j][r];
+                            }
+                        }
+                        mubuf[l] = pr.mu;
+                        any_mu |= pr.mu > T::ZERO;
+                        live[l] = true;
+                    }
+                    Err(e) => self.first.note(start + l, Err(e)),
+                }
+            }
+            for l in len..lanes {
+                for d in 0..D {
+                    fbuf[d * (D + 1)][l] = T::ONE;
+                }
+            }
+            for (x, pr) in xs.iter_mut().zip(&pres).take(len) {
+                *x = pr.p.x;
+            }
+            let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils);
+            let mut tbuf = [[T::ZERO; MAX_LANES]; 9];
+            let mut lane_err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            if any_mu {
+                // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
+                let mut f: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
+                for j in 0..D {
+                    for r in 0..D {
+                        f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
+                    }
+                }
+                let (co, ck) = evaluate(V::load(&mubuf[..lanes]), &f);
+                let tau = mul_nt(&ahat(&co), &f);
+                for j in 0..D {
+                    for r in 0..D {
+                        tau[j][r].store(&mut tbuf[r + D * j][..lanes]);
+                    }
+                }
+                let bits = check_bits::<V>(&ck);
+                for (l, e) in lane_err.iter_mut().enumerate().take(len) {
+                    // Lanes with μ = 0 ran no decomposition in the scalar path either.
+                    if mubuf[l] > T::ZERO {
+                        *e = lane_error(&bits, l);
+                    }
+                }
+            }
+            for l in 0..len {
+                if live[l] {
+                    if let Some(e) = lane_err[l] {
+                        self.first.note(start + l, Err(e));
+                        continue;
+                    }
+                    let mut tau = Mat::<T, D>::ZERO;
+                    for j in 0..D {
+                        for r in 0..D {
+                            tau.cols[j][r] = tbuf[r + D * j][l];
+                        }
+                    }
+                    // SAFETY: `p2g`'s contract: valid channels over the box.
+                    unsafe {
+                        self.finish::<R, K, N>(
+                            start + l,
+                            &pres[l],
+                            tau,
+                            (done >> l & 1 == 1).then_some(&stencils[l]),
+                            &mut tile,
+                            &mut run,
+                            &oc,
+                            &mut coef,
+                        )
+                    };
+                }
+            }
+            start += len;
+        }
+        // SAFETY: as above.
+        unsafe { self.flush::<R, K, N>(&mut tile, &mut run, &oc) };
+        self.first.status()
+    }
+}
