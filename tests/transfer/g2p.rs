@@ -156,9 +156,9 @@ where
 /// them) with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
 /// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node
 /// velocity), and one whose `F_E` has a subnormal column (the liquid projection's scalings
-/// leave the normal range). Liquid batches
-/// also have isotropic and general `F_P` and an `F_E` with columns of very different scales
-/// (the projection's root on equilibrated columns), in chunks that stay on lanes.
+/// leave the normal range). Liquid batches also have isotropic and general `F_P` and an `F_E`
+/// with columns of very different scales (the projection's root on equilibrated columns), in
+/// chunks that stay on lanes.
 fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,

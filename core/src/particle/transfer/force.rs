@@ -11,7 +11,8 @@
 use super::nodes::NodeVals;
 use super::nodes::{add, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes};
 use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_RUN, TILE_X};
-use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, OutChannel};
+use super::OutChannel;
+use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
@@ -314,14 +315,9 @@ where
         let mut start = 0;
         while start < self.n {
             let len = TILE_X.min(self.n - start);
-            for (k, x) in xs.iter_mut().enumerate().take(len) {
-                // SAFETY: `apply`'s contract (particle `start + k < n`).
-                *x = unsafe { rd_vec::<T, D>(self.x, start + k) };
-            }
-            let done = if R::LANES == TILE_X {
-                Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, &xs, &mut stencils)
-            } else {
-                0
+            // SAFETY: `apply`'s contract (particles `start..start + len` of `n`).
+            let done = unsafe {
+                chunk_stencils::<T, R, D>(kernel, h, self.x, (start, len), &mut xs, &mut stencils)
             };
             for k in 0..len {
                 // SAFETY: as above.

@@ -12,7 +12,8 @@
 
 use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes, NodeVals};
 use super::update_lanes::{self, ChunkSamples};
-use super::{rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox, Particles, Reads};
+use super::{chunk_stencils, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
+use super::{Particles, Reads};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
@@ -179,14 +180,16 @@ where
         let mut start = 0;
         while start < self.n {
             let len = CHUNK.min(self.n - start);
-            for (k, x) in xs.iter_mut().enumerate().take(len) {
-                // SAFETY: `g2p_update`'s contract (particle `start + k < n`).
-                *x = unsafe { rd_vec::<T, D>(self.ps.x, start + k) };
-            }
-            let done = if R::LANES == CHUNK {
-                Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, &xs, &mut stencils)
-            } else {
-                0
+            // SAFETY: `g2p_update`'s contract (particles `start..start + len` of `n`).
+            let done = unsafe {
+                chunk_stencils::<T, R, D>(
+                    kernel,
+                    h,
+                    self.ps.x,
+                    (start, len),
+                    &mut xs,
+                    &mut stencils,
+                )
             };
             let mut all_ok = true;
             for (k, (out, st)) in samples.iter_mut().zip(&mut status).enumerate().take(len) {

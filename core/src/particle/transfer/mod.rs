@@ -188,6 +188,33 @@ unsafe fn wr<T: Copy>(p: *mut T, i: usize, v: T) {
     ptr::write_unaligned(p.add(i), v)
 }
 
+/// The positions of particles `start..start + len` (array `x`, `d` scalars per particle)
+/// into `xs`, and their collocated stencils into `out` on the lanes of `R` when a chunk is one
+/// row of lanes (`xs.len() == R::LANES`). Returns the lanes whose stencil is done (see
+/// [`Stencil::new_lanes`]; none otherwise): the caller builds the others with
+/// [`Stencil::new`], which gives their errors. Entries from `len` on are left as they are.
+///
+/// # Safety
+/// `x` holds particles `start..start + len`; `len ≤ xs.len() = out.len()`.
+#[inline(always)]
+unsafe fn chunk_stencils<T: Real, R: crate::lane::Lane<Scalar = T>, const D: usize>(
+    kernel: Kernel,
+    h: T,
+    x: *const T,
+    (start, len): (usize, usize),
+    xs: &mut [[T; D]],
+    out: &mut [Stencil<T, D>],
+) -> u32 {
+    for (k, xk) in xs.iter_mut().enumerate().take(len) {
+        *xk = rd_vec::<T, D>(x, start + k);
+    }
+    if xs.len() == R::LANES {
+        Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, xs, out)
+    } else {
+        0
+    }
+}
+
 #[inline(always)]
 pub(crate) unsafe fn rd_vec<T: Real, const D: usize>(p: *const T, i: usize) -> [T; D] {
     let mut v = [T::ZERO; D];
