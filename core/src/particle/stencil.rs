@@ -186,34 +186,14 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     /// finite `h > 0` so small that `1/h` is not representable.
     #[inline(always)]
     pub fn new(kernel: Kernel, grid: Grid, h: T, x: &[T; D]) -> Result<Self> {
-        let inv_h = Self::inv_spacing(grid, h, x)?;
-        let mut s = Self::blank(kernel, h);
-        for a in 0..D {
-            let (xi, xi64) = cell_coordinate(grid, a, inv_h, x[a])?;
-            // ⌊ξ⌋ by truncation (|ξ| < 2³⁰ was checked, so the conversion is exact).
-            let t = xi64 as i64 as f64;
-            let fl = if t > xi64 { t - 1.0 } else { t };
-            // Exact: ξ − ⌊ξ⌋ (Sterbenz for |ξ| ≥ 1, trivially below), in [0, 1).
-            let frac = xi - T::from_f64(fl);
-            let fl = fl as i32;
-            // fx: distance of the particle from the base node, in cells.
-            let (base, fx) = match kernel {
-                // Nearest node is base+1: base = ⌊ξ − ½⌋.
-                Kernel::Quadratic if frac < T::HALF => (fl - 1, frac + T::ONE),
-                Kernel::Quadratic => (fl, frac),
-                // Base = ⌊ξ⌋ − 1, two nodes on each side.
-                Kernel::Cubic => (fl - 1, frac + T::ONE),
-            };
-            s.base[a] = base;
-            s.fx[a] = fx;
-            for o in 0..kernel.width() {
-                let (n, dn) = kernel.n_dn(fx - T::from_i32(o as i32));
-                s.w[a][o] = n;
-                // |N'| ≤ 1 for both kernels, so this is at most 1/h: finite.
-                s.dw[a][o] = dn * inv_h;
-            }
+        // The checks give the statuses; the formulas are those of `new_lanes` on one lane.
+        Self::check_position(grid, h, x)?;
+        let mut s = [Self::blank(kernel, h)];
+        if Self::new_lanes::<T>(kernel, grid, h, core::slice::from_ref(x), &mut s) & 1 == 0 {
+            // Not reached: `check_position` accepts exactly the lanes `new_lanes` does.
+            return Err(Error::InvalidArgument);
         }
-        Ok(s)
+        Ok(s[0])
     }
 
     /// A stencil with every weight 0 and base 0 (a placeholder to be overwritten).
@@ -243,14 +223,17 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     }
 
     /// The stencils of `V::LANES` particles at once (positions `xs[l]`) on SIMD lanes, into
-    /// `out[l]`. Returns the lanes done (bit `l` for lane `l`): there `out[l]` is
-    /// `Stencil::new(kernel, grid, h, &xs[l])` with the same bits. A lane is not done when
-    /// its `Stencil::new` would fail (or `h` or `grid` is invalid: no lane is done); the
-    /// caller calls `Stencil::new` there and gets its error.
+    /// `out[l]`; [`Stencil::new`] is this on one lane. Returns the lanes done (bit `l` for
+    /// lane `l`): there `out[l]` is `Stencil::new(kernel, grid, h, &xs[l])`. A lane is not
+    /// done when its `Stencil::new` would fail (or `h` or `grid` is invalid: no lane is done);
+    /// the caller calls `Stencil::new` there and gets its error.
     ///
-    /// Same operations per lane as [`Stencil::new`]: `ξ = x/h − shift`, `⌊ξ⌋` (exact in `T`
-    /// for `|ξ| < 2³⁰`: a value of `T` that large is an integer), `frac = ξ − ⌊ξ⌋`, the base
-    /// choice, and [`Kernel::n_dn_lanes`].
+    /// Per axis: `ξ = x/h − shift`; `⌊ξ⌋` (exact: `|ξ| < 2³⁰` is checked, and a value of `T`
+    /// that large is an integer); `frac = ξ − ⌊ξ⌋`, exact (Sterbenz for `|ξ| ≥ 1`, trivially
+    /// below), in `[0, 1)`; the base node (quadratic: `⌊ξ − ½⌋`, the nearest node is base + 1;
+    /// cubic: `⌊ξ⌋ − 1`, two nodes on each side) and `fx`, the particle's distance from it in
+    /// cells; then [`Kernel::n_dn_lanes`] at `fx − o`, the derivative times `1/h` (finite:
+    /// `|N'| ≤ 1` for both kernels).
     #[inline(always)]
     pub(crate) fn new_lanes<V: Lane<Scalar = T>>(
         kernel: Kernel,

@@ -1,4 +1,5 @@
-//! The stencils on lanes ([`Stencil::new_lanes`]) against the scalar [`Stencil::new`], bit for
+//! The stencils on SIMD lanes ([`Stencil::new_lanes`]) against the one-lane [`Stencil::new`]
+//! (which `tests/particle.rs` checks against an independent f64 B-spline), bit for
 //! bit, on every lane type the CPU has.
 
 use super::{Grid, Kernel, Stencil, MAX_CELLS};
