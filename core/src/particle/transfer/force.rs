@@ -9,7 +9,9 @@
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
 use super::nodes::NodeVals;
-use super::nodes::{add, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes};
+use super::nodes::{
+    add, node_sums, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes,
+};
 use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use super::OutChannel;
 use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
@@ -386,7 +388,7 @@ where
                 tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
             }
         };
-        let (w, dw) = axis0::<T, R, D, K>(s, sp[0]);
+        let (w, dw, _) = axis0::<T, R, D, K>(s, sp[0]);
         let mut coef = [Coef::only(R::splat(T::ZERO)); D];
         for (a, c) in coef.iter_mut().enumerate() {
             set_grad(c, w, dw, m, a, T::ONE);
@@ -471,7 +473,7 @@ where
     }
 }
 
-/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`) in order.
+/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`), by [`node_sums`].
 ///
 /// # Safety
 /// `apply`'s contract; the stencil is inside the box.
@@ -493,12 +495,7 @@ unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     }
     // G row by row: lanes 1 + d + b of Σ_j δu_{a,j} m_j are Σ_j δu_{a,j} ∂w_j/∂x_b.
     let m = rows::<T, R, D, K, N>(s, cst);
-    let mut sum = [R::splat(T::ZERO); D];
-    for j in 0..N {
-        for a in 0..D {
-            sum[a] += R::splat(u[a].v[j]) * m[j];
-        }
-    }
+    let sum = node_sums::<T, R, D, K, N>(&m, &u, (0, D));
     let mut g = Mat::<T, D>::ZERO;
     for a in 0..D {
         let mut l = [T::ZERO; 8];

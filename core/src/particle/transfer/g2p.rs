@@ -10,7 +10,9 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{read, rel_base, row_consts, rows, table, taint, with_nodes, NodeVals};
+use super::nodes::{
+    node_sums, read, rel_base, row_consts, rows, table, taint, with_nodes, NodeVals,
+};
 use super::update_lanes::{self, ChunkSamples};
 use super::{chunk_stencils, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
@@ -301,9 +303,9 @@ where
 }
 
 /// Sums over the velocity channels of one stencil (components `comps`): per component
-/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite. The sums run
-/// over the nodes in order; the `1 + 2d` sums of a component are one short vector
-/// `Σ_i v_i m_i` over the node rows `m` of [`rows`].
+/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite. The `1 + 2d`
+/// sums of a component are one short vector `Σ_i v_i m_i` over the node rows `m` of [`rows`]
+/// ([`node_sums`]).
 #[inline(always)]
 unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
     m: &[R; N],
@@ -322,14 +324,7 @@ unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, con
         let t = table(&ch[a], rel);
         chk &= read::<T, R, D, K, N>(ch[a].data, &t, ch[a].stride[0], &mut q[a]);
     }
-    let mut sum = [R::splat(T::ZERO); D];
-    for i in 0..N {
-        for a in 0..D {
-            if on(a) {
-                sum[a] += R::splat(q[a].v[i]) * m[i];
-            }
-        }
-    }
+    let sum = node_sums::<T, R, D, K, N>(m, &q, comps);
     let mut acc = [[T::ZERO; 8]; D];
     for a in 0..D {
         sum[a].store(&mut acc[a]);

@@ -34,7 +34,7 @@
 //! adding its particles one by one would pass through a non-finite value (the sum of two
 //! huge opposite contributions): the run is then accepted, with the finite, more accurate sum.
 
-use super::nodes::{row_factors, Offsets};
+use super::nodes::{lane_index, row_factors, Offsets};
 use super::OutChannel;
 use crate::lane::Lane;
 use crate::mat::Mat;
@@ -310,16 +310,22 @@ unsafe fn store_row<T: Real, R: Lane<Scalar = T>>(v: R, p: *mut T, s0: isize, bi
 }
 
 /// The axis-0 weights and weight derivatives (1/m) of a stencil in tile lanes `s0..s0 + K`,
-/// zero in the other lanes.
+/// zero in the other lanes, and every lane's axis-0 node offset `l − s0` from the stencil's
+/// base (exact small integers). Put together in registers by lane selects: lanes stored one
+/// scalar at a time and then loaded as a vector would wait for the stores to reach the cache.
 #[inline(always)]
 pub(super) fn axis0<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
     s: &Stencil<T, D>,
     s0: usize,
-) -> (R, R) {
-    let (mut wl, mut dl) = ([T::ZERO; TILE_X], [T::ZERO; TILE_X]);
-    wl[s0..s0 + K].copy_from_slice(&s.w[0][..K]);
-    dl[s0..s0 + K].copy_from_slice(&s.dw[0][..K]);
-    (R::load(&wl), R::load(&dl))
+) -> (R, R, R) {
+    let o = lane_index::<T, R>() - R::splat(T::from_i32(s0 as i32));
+    let (mut w, mut dw) = (R::splat(T::ZERO), R::splat(T::ZERO));
+    for k in 0..K {
+        let here = o.eq(R::splat(T::from_i32(k as i32)));
+        w = R::select(here, R::splat(s.w[0][k]), w);
+        dw = R::select(here, R::splat(s.dw[0][k]), dw);
+    }
+    (w, dw, o)
 }
 
 /// Sets `c` to the [`Coef`] of the node values `f Σ_b m_{ab} ∂w/∂x_b` (a force: row `a` of

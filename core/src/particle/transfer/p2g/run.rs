@@ -104,13 +104,8 @@ where
         out: &mut [Coef<R, D>; MAX_CH],
     ) {
         let sp = R::splat;
-        let (w, dw) = axis0::<T, R, D, K>(r.s, s0);
-        // The axis-0 node offsets o₀ of the lanes (exact small integers).
-        let mut lane = [T::ZERO; TILE_X];
-        for (l, x) in lane.iter_mut().enumerate() {
-            *x = T::from_i32(l as i32 - s0 as i32);
-        }
-        let o0 = R::load(&lane);
+        // With the axis-0 node offsets o₀ of the lanes.
+        let (w, dw, o0) = axis0::<T, R, D, K>(r.s, s0);
         let idt = self.args.impulse_dt;
         for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
             match kind {
