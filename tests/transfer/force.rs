@@ -1,4 +1,5 @@
-//! The force differential: reference stiffness, PSD option, unprepared slots, overflowing runs.
+//! The force differential: reference stiffness (one particle and batches), PSD option, unprepared
+//! slots, overflowing runs.
 use crate::{materials, particles, runs_of_particles, DenseGrid, Store, FORCE, MOM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::kernel::{Dim, LaneDim};
@@ -303,4 +304,117 @@ fn apply_run_that_overflows_is_added_one_by_one() {
             "{isa:?}: only particle 2 was written"
         );
     }
+}
+
+/// `apply` over many particles (full chunks of lanes and a partial one, on every instruction
+/// set) against the reference [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
+/// `M_p = d_force_matrix(Σ_j δu_j ∇w_jpᵀ)`, summed in f64. Tolerance per node component:
+/// the single-particle test's `1024 ε` times the sum over particles of each one's largest
+/// node contribution.
+fn apply_batch_matches_reference<T: BatchReal, const D: usize>()
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]> + HessianDim,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf, n) = (12, 0.05, 21);
+    let h = T::from_f64(hf);
+    let eps = T::EPSILON.to_f64();
+    for (name, base) in materials::<T>() {
+        let mat = Material {
+            hessian: Definiteness::Exact,
+            ..base
+        };
+        let mut rng = Pcg64::seed_from_u64(29);
+        let ps = particles::<T, D>(&mut rng, n, hf, cells, &mat);
+        let mut du = DenseGrid::<T, D>::new([0; D], [cells; D]);
+        for a in 0..D {
+            for x in du.ch[MOM + a].iter_mut() {
+                *x = T::from_f64(rng.random_range(-1.0e-3..1.0e-3));
+            }
+        }
+        // The reference, and per node component the tolerance's scale.
+        let len = du.ch[MOM].len();
+        let mut want = vec![[0.0f64; D]; len];
+        let mut scale = 0.0f64;
+        for p in &ps {
+            let e = elastic_energy(&mat, p).unwrap();
+            let st = Stiffness::new(&e, &mat, p).unwrap();
+            let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &p.x).unwrap();
+            let mut g = Mat::<T, D>::ZERO;
+            for j in 0..s.len() {
+                let nd = s.node(j);
+                let k = du.index(nd.index);
+                for a in 0..D {
+                    for b in 0..D {
+                        g.cols[b][a] += du.ch[MOM + a][k] * nd.grad[b];
+                    }
+                }
+            }
+            let m = st.d_force_matrix(&g).unwrap();
+            let mut largest = 0.0f64;
+            for i in 0..s.len() {
+                let nd = s.node(i);
+                let f = m.mul_vec(nd.grad);
+                for a in 0..D {
+                    want[du.index(nd.index)][a] += f[a].to_f64();
+                    largest = largest.max(f[a].to_f64().abs());
+                }
+            }
+            scale += largest;
+        }
+        let mut store = Store::from(&ps);
+        for isa in Isa::available() {
+            let mut slots = vec![T::ZERO; n * slot_len(D)];
+            // SAFETY: n particles, n slots.
+            let st =
+                unsafe { force::prepare::<T, D>(isa, &mat, n, &store.raw(), slots.as_mut_ptr()) };
+            assert_eq!(st.error, None, "{name} {isa:?}");
+            let mut df = DenseGrid::<T, D>::new([0; D], [cells; D]);
+            let view = ForceView {
+                nodes: du.nodes(),
+                du: std::array::from_fn(|a| du.inp(MOM + a)),
+                df: std::array::from_fn(|a| df.out(FORCE + a)),
+            };
+            // SAFETY: n particles and slots; the channels cover every stencil.
+            let st = unsafe {
+                force::apply::<T, D>(
+                    isa,
+                    Kernel::Quadratic,
+                    h,
+                    n,
+                    store.x.as_ptr(),
+                    slots.as_ptr(),
+                    &view,
+                )
+            };
+            assert_eq!(st.error, None, "{name} {isa:?}");
+            for (k, w) in want.iter().enumerate() {
+                for a in 0..D {
+                    let got = df.ch[FORCE + a][k].to_f64();
+                    assert!(
+                        (got - w[a]).abs() <= 1024.0 * eps * scale,
+                        "{name} {isa:?}: node {k} axis {a}: {got} vs {} (scale {scale})",
+                        w[a]
+                    );
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn apply_batch_matches_reference_3d_f32() {
+    apply_batch_matches_reference::<f32, 3>();
+}
+
+#[test]
+fn apply_batch_matches_reference_3d_f64() {
+    apply_batch_matches_reference::<f64, 3>();
+}
+
+#[test]
+fn apply_batch_matches_reference_2d_f64() {
+    apply_batch_matches_reference::<f64, 2>();
 }

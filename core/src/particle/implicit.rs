@@ -31,7 +31,7 @@
 //! per pair ([`crate::kernel::PAIRS`] order) `(a, b, c)` of `−V⁰ [[a, b], [b, c]]`.
 
 use crate::kernel::{pairs, psd_block, Coeffs, Dim, LaneDim, PAIRS};
-use crate::lane::lmat::{c, LMat};
+use crate::lane::lmat::{c, mul, mul_nt, mul_tn, LMat};
 use crate::lane::Lane;
 use crate::mat::Mat;
 use crate::scalar::Real;
@@ -173,62 +173,54 @@ pub fn entries<V: Lane, const D: usize>(b: &Blocks<V, D>, mut put: impl FnMut(us
 }
 
 /// `M = U (−V⁰ H(Uᵀ G U)) Uᵀ` from a slot (scalars): the node force differential is `M ∇w_i`.
+/// [`apply_entries`] on one lane.
 #[inline(always)]
 #[must_use]
 pub fn apply_slot<T: Real, const D: usize>(slot: &[T], g: &Mat<T, D>) -> Mat<T, D> {
-    let mut u = Mat::<T, D>::ZERO;
-    let mut o = 1;
-    for j in 0..D {
-        for i in 0..D {
-            u.cols[j][i] = slot[o];
+    Mat {
+        cols: apply_entries::<T, D>(&slot[1..], &g.cols),
+    }
+}
+
+/// [`apply_slot`] on lanes: `e[k]` is slot entry `1 + k` of each lane's particle, `g` its `G`
+/// (column-major, `g[j][i] = G_ij`); returns `M` column-major.
+#[inline(always)]
+#[must_use]
+pub fn apply_entries<V: Lane, const D: usize>(e: &[V], g: &LMat<V, D>) -> LMat<V, D> {
+    let z = V::splat(V::Scalar::ZERO);
+    let mut u = [[z; D]; D];
+    let mut o = 0;
+    for col in u.iter_mut() {
+        for x in col.iter_mut() {
+            *x = e[o];
             o += 1;
         }
     }
-    // Ĝ = Uᵀ G U.
-    let gu = *g * u;
-    let mut gh = Mat::<T, D>::ZERO;
-    for j in 0..D {
-        for i in 0..D {
-            let mut s = T::ZERO;
-            for k in 0..D {
-                s += u.cols[i][k] * gu.cols[j][k];
-            }
-            gh.cols[j][i] = s;
-        }
-    }
-    let mut mh = Mat::<T, D>::ZERO;
-    let mut dg = [T::ZERO; D];
+    // Ĝ = Uᵀ (G U).
+    let gh = mul_tn(&u, &mul(g, &u));
+    // M̂: the diagonal block on (Ĝ_11, …, Ĝ_dd), the pair blocks on (Ĝ_ij, Ĝ_ji).
+    let mut mh = [[z; D]; D];
+    let mut dg = [z; D];
     for j in 0..D {
         for i in 0..=j {
-            let v = slot[o];
+            let v = e[o];
             o += 1;
-            dg[i] += v * gh.cols[j][j];
+            dg[i] += v * gh[j][j];
             if i != j {
-                dg[j] += v * gh.cols[i][i];
+                dg[j] += v * gh[i][i];
             }
         }
     }
     for i in 0..D {
-        mh.cols[i][i] = dg[i];
+        mh[i][i] = dg[i];
     }
     for &(i, j) in PAIRS.iter().take(pairs(D)) {
-        let (a, b, cc) = (slot[o], slot[o + 1], slot[o + 2]);
+        let (a, b, cc) = (e[o], e[o + 1], e[o + 2]);
         o += 3;
-        let (gij, gji) = (gh.cols[j][i], gh.cols[i][j]);
-        mh.cols[j][i] = a * gij + b * gji;
-        mh.cols[i][j] = b * gij + cc * gji;
+        let (gij, gji) = (gh[j][i], gh[i][j]);
+        mh[j][i] = a * gij + b * gji;
+        mh[i][j] = b * gij + cc * gji;
     }
-    // M = U M̂ Uᵀ.
-    let um = u * mh;
-    let mut m = Mat::<T, D>::ZERO;
-    for j in 0..D {
-        for i in 0..D {
-            let mut s = T::ZERO;
-            for k in 0..D {
-                s += um.cols[k][i] * u.cols[k][j];
-            }
-            m.cols[j][i] = s;
-        }
-    }
-    m
+    // M = (U M̂) Uᵀ.
+    mul_nt(&mul(&u, &mh), &u)
 }

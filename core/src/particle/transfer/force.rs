@@ -23,7 +23,7 @@ use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::LMat;
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
-use crate::particle::implicit::{apply_slot, blocks, entries, slot_len, tag};
+use crate::particle::implicit::{apply_entries, apply_slot, blocks, entries, slot_len, tag};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::check_particle;
 use crate::particle::{Definiteness, Dilation, Material};
@@ -298,8 +298,11 @@ where
     /// `δf` goes into a node tile ([`super::tile`]) that is added to `df` per run of nearby
     /// particles; a run whose sum would not be finite is added again one particle at a time
     /// ([`one`]), which refuses the particles that overflow. Particles go in chunks of
-    /// [`TILE_X`]: the chunk's stencils on lanes, then each particle's `M` (reads of `δu`,
-    /// written in place), then the tile (writes of `δf`, which no read of `δu` sees).
+    /// [`TILE_X`]: the chunk's stencils on lanes, then each particle's `G` (reads of `δu`,
+    /// written in place), then the chunk's `M = 𝒜(G)` ([`apply_entries`] on lanes when every
+    /// particle of a full chunk got its `G`, one by one otherwise: the same formulas, whose
+    /// multiply-adds are fused on the vector instruction sets), then the tile (writes of
+    /// `δf`, which no read of `δu` sees).
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
@@ -312,8 +315,10 @@ where
         let mut xs = [[T::ZERO; D]; TILE_X];
         let mut stencils = [Stencil::blank(kernel, h); TILE_X];
         let mut rels = [[0isize; D]; TILE_X];
+        let mut gs = [Mat::<T, D>::ZERO; TILE_X];
         let mut ms = [Mat::<T, D>::ZERO; TILE_X];
         let mut live = [false; TILE_X];
+        let sl = slot_len(D);
         let mut start = 0;
         while start < self.n {
             let len = TILE_X.min(self.n - start);
@@ -331,11 +336,24 @@ where
                         &cst,
                         &mut stencils[k],
                         &mut rels[k],
-                        &mut ms[k],
+                        &mut gs[k],
                     )
                 };
                 live[k] = r.is_ok();
                 first.note(start + k, r);
+            }
+            if len == TILE_X && live.iter().all(|&l| l) {
+                // SAFETY: `apply`'s contract: slots `start..start + TILE_X` of `n`; `gs` and
+                // `ms` are `repr(C)` matrices of `d²` scalars each.
+                unsafe { apply_chunk::<T, R, D>(self.slots.add(start * sl), sl, &gs, &mut ms) };
+            } else {
+                for k in 0..len {
+                    if live[k] {
+                        // SAFETY: `apply`'s contract; a live particle's slot was checked.
+                        let slot = unsafe { self.slot(start + k) };
+                        ms[k] = apply_slot(slot, &gs[k]);
+                    }
+                }
             }
             for k in 0..len {
                 if live[k] {
@@ -410,12 +428,22 @@ where
     ) -> Result<(Stencil<T, D>, [isize; D], Mat<T, D>)> {
         let xp = rd_vec::<T, D>(self.x, i);
         let mut s = Stencil::blank(self.kernel, self.h);
-        let (mut rel, mut m) = ([0; D], Mat::ZERO);
-        self.gather_with::<R, K, N>(i, &xp, false, cst, &mut s, &mut rel, &mut m)?;
-        Ok((s, rel, m))
+        let (mut rel, mut g) = ([0; D], Mat::ZERO);
+        self.gather_with::<R, K, N>(i, &xp, false, cst, &mut s, &mut rel, &mut g)?;
+        Ok((s, rel, apply_slot(self.slot(i), &g)))
     }
 
-    /// [`Self::gather`] of particle `i` at `xp` into `s`, `rel`, `m` (in part on error; built
+    /// Particle `i`'s slot.
+    ///
+    /// # Safety
+    /// `apply`'s contract (`i < n`).
+    #[inline(always)]
+    unsafe fn slot(&self, i: usize) -> &[T] {
+        let sl = slot_len(D);
+        core::slice::from_raw_parts(self.slots.add(i * sl), sl)
+    }
+
+    /// [`Self::gather`] of particle `i` at `xp` into `s`, `rel` and `G` (in part on error; built
     /// in place, for the reason given at [`super::Particles::read_into`]); with `lane`, `s`
     /// already holds the stencil of `xp` ([`Stencil::new_lanes`]). Statuses in the order of
     /// the checks: slot, stencil, box, `δu`.
@@ -432,19 +460,16 @@ where
         cst: &[[T; 8]; N],
         s: &mut Stencil<T, D>,
         rel: &mut [isize; D],
-        m: &mut Mat<T, D>,
+        g: &mut Mat<T, D>,
     ) -> Result<()> {
-        let sl = slot_len(D);
-        let slot = core::slice::from_raw_parts(self.slots.add(i * sl), sl);
-        if slot[0] != tag::<T>(D) {
+        if self.slot(i)[0] != tag::<T>(D) {
             return Err(Error::NotPrepared);
         }
         if !lane {
             *s = Stencil::new(self.kernel, Grid::Collocated, self.h, xp)?;
         }
         *rel = rel_base(s, &self.view.nodes)?;
-        let g = grad_u::<T, R, D, K, N>(s, rel, self.view, cst)?;
-        *m = apply_slot(slot, &g);
+        *g = grad_u::<T, R, D, K, N>(s, rel, self.view, cst)?;
         Ok(())
     }
 
@@ -469,6 +494,42 @@ where
                 .gather::<R, K, N>(i, cst)
                 .and_then(|(s, rel, m)| one::<T, D, K, N>(&s, &rel, &m, self.view));
             first.note(i, r);
+        }
+    }
+}
+
+/// `M = 𝒜(G)` of [`TILE_X`] consecutive particles on lanes ([`apply_entries`]): `slots` the
+/// first one's slot (each `sl` scalars), `gs` their `G`, `ms` their `M`.
+///
+/// # Safety
+/// `slots` is valid for reading `TILE_X·sl` scalars.
+#[inline(always)]
+unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
+    slots: *const T,
+    sl: usize,
+    gs: &[Mat<T, D>; TILE_X],
+    ms: &mut [Mat<T, D>; TILE_X],
+) {
+    debug_assert_eq!(R::LANES, TILE_X);
+    let z = R::splat(T::ZERO);
+    // Slot entries 1.. (after the tag), at most 24 (3D).
+    let mut e = [z; 24];
+    for (k, x) in e.iter_mut().enumerate().take(sl - 1) {
+        *x = R::gather(slots.add(1 + k), sl);
+    }
+    // `Mat` is `repr(C)` around `[[T; D]; D]`: entry (i, j) of particle `l` is scalar
+    // `l·d² + j·d + i` of the arrays.
+    let (gp, mp) = (gs.as_ptr().cast::<T>(), ms.as_mut_ptr().cast::<T>());
+    let mut g = [[z; D]; D];
+    for (j, col) in g.iter_mut().enumerate() {
+        for (i, x) in col.iter_mut().enumerate() {
+            *x = R::gather(gp.add(j * D + i), D * D);
+        }
+    }
+    let m = apply_entries::<R, D>(&e[..sl - 1], &g);
+    for (j, col) in m.iter().enumerate() {
+        for (i, x) in col.iter().enumerate() {
+            x.scatter(mp.add(j * D + i), D * D, u32::MAX);
         }
     }
 }
