@@ -2,7 +2,9 @@
 # toolchain lacks, or say exactly what is missing.
 set -euo pipefail
 
-say() { printf '==> %s\n' "$*"; }
+# Each step is stamped with the seconds since the script started (bash's SECONDS), so a log
+# shows where the time goes.
+say() { printf '==> [%5d s] %s\n' "$SECONDS" "$*"; }
 
 need_cmd() {
   command -v "$1" >/dev/null 2>&1 || { say "missing: $1 ($2)"; exit 1; }

@@ -512,8 +512,8 @@ unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
 ) {
     debug_assert_eq!(R::LANES, TILE_X);
     let z = R::splat(T::ZERO);
-    // Slot entries 1.. (after the tag), at most 24 (3D).
-    let mut e = [z; 24];
+    // Slot entries 1.. (after the tag): at most those of a 3D slot.
+    let mut e = [z; slot_len(3) - 1];
     for (k, x) in e.iter_mut().enumerate().take(sl - 1) {
         *x = R::gather(slots.add(1 + k), sl);
     }
