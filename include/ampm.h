@@ -58,8 +58,8 @@
  * in local tiles (c_tests/test_stack measures every call on every instruction set). Run the
  * particle calls on threads or fibers with at least 96 KiB of stack.
  *
- * Instruction sets. Batch calls run on the widest instruction set the CPU supports (AVX-512F,
- * AVX2 + FMA, or scalar), detected at first use; ampm_set_isa chooses another (AMPM_ISA_*)
+ * Instruction sets. Batch calls run on the widest instruction set the CPU supports (AVX-512
+ * F/VL/DQ/BW, AVX2 + FMA, or scalar), detected at first use; ampm_set_isa chooses another (AMPM_ISA_*)
  * and ampm_isa tells which is in use. Results are identical on the AVX2 and AVX-512 paths;
  * the scalar path, which the single calls use, agrees with them to a few ulps times the
  * conditioning of F.
@@ -200,7 +200,7 @@
 #define AMPM_ISA_AVX2 1
 
 /**
- * `ampm_set_isa` / `ampm_isa`: x86-64 AVX-512F, 32 f32 or 16 f64 particles per step.
+ * `ampm_set_isa` / `ampm_isa`: x86-64 AVX-512 (F, VL, DQ, BW), 32 f32 or 16 f64 particles per step.
  */
 #define AMPM_ISA_AVX512 2
 

@@ -14,7 +14,7 @@ pub use crate::generated::prepared::*;
 pub const AMPM_ISA_SCALAR: u32 = 0;
 /// `ampm_set_isa` / `ampm_isa`: x86-64 AVX2 + FMA, 16 f32 or 8 f64 particles per step.
 pub const AMPM_ISA_AVX2: u32 = 1;
-/// `ampm_set_isa` / `ampm_isa`: x86-64 AVX-512F, 32 f32 or 16 f64 particles per step.
+/// `ampm_set_isa` / `ampm_isa`: x86-64 AVX-512 (F, VL, DQ, BW), 32 f32 or 16 f64 particles per step.
 pub const AMPM_ISA_AVX512: u32 = 2;
 
 /// Chooses the instruction set of every batch call (`AMPM_ISA_*`); by default the widest the

@@ -115,7 +115,7 @@ unsafe fn run_avx2<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx512f,avx2,fma")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
 unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
     op.run_rows::<T::Avx512, T::Avx512Row>()
 }

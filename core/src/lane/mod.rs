@@ -7,7 +7,7 @@
 //! - on one `f32` or `f64` ([`Lane`] is implemented for every [`Real`]): the single-particle
 //!   API, and the only form on targets without SIMD (`no_std`, `thumbv7em-none-eabihf`);
 //! - on x86-64 vectors (`x86` module, crate-private): `f32×8`/`f64×4` with AVX2+FMA and
-//!   `f32×16`/`f64×8` with AVX-512F. They are reachable only through the batch entry points
+//!   `f32×16`/`f64×8` with AVX-512 (F, VL, DQ, BW). They are reachable only through the batch entry points
 //!   of [`crate::kernel`], which take an [`Isa`] that proves the CPU supports them.
 //!
 //! **Bits.** The vector paths use only operations that round the same way on AVX2 and
@@ -333,7 +333,10 @@ pub enum IsaKind {
     Scalar,
     /// x86-64 AVX2 + FMA: `f32×8`, `f64×4`.
     Avx2,
-    /// x86-64 AVX-512F (+ AVX2 + FMA): `f32×16`, `f64×8`.
+    /// x86-64 AVX-512 F, VL, DQ and BW (+ AVX2 + FMA): `f32×16`, `f64×8`. VL lets the
+    /// eight-lane rows of the particle transfers use 32 registers and masked moves that
+    /// are not microcoded (AMD Zen 4: the force differential's apply about 15 % faster than
+    /// with AVX-512F alone, measured in one run).
     Avx512,
 }
 
@@ -374,7 +377,7 @@ impl Isa {
     ///
     /// # Safety
     /// The CPU running every kernel called with the result must support the kind's
-    /// instructions (AVX2 and FMA; for [`IsaKind::Avx512`] also AVX-512F).
+    /// instructions (AVX2 and FMA; for [`IsaKind::Avx512`] also AVX-512 F, VL, DQ and BW).
     #[inline]
     #[must_use]
     pub const unsafe fn assume(kind: IsaKind) -> Isa {
@@ -399,8 +402,9 @@ impl Isa {
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
                 v.push(Isa(IsaKind::Avx2));
                 if std::is_x86_feature_detected!("avx512f")
-                    && std::is_x86_feature_detected!("avx2")
-                    && std::is_x86_feature_detected!("fma")
+                    && std::is_x86_feature_detected!("avx512vl")
+                    && std::is_x86_feature_detected!("avx512dq")
+                    && std::is_x86_feature_detected!("avx512bw")
                 {
                     v.push(Isa(IsaKind::Avx512));
                 }

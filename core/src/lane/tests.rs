@@ -76,7 +76,7 @@ fn partial_loads_and_stores() {
             partial::<super::F64x4>();
             partial::<X2<super::F32x8>>();
         }
-        #[target_feature(enable = "avx512f,avx2,fma")]
+        #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
         unsafe fn avx512() {
             partial::<super::F32x16>();
             partial::<super::F64x8>();
@@ -87,10 +87,13 @@ fn partial_loads_and_stores() {
             unsafe { avx2() };
         }
         if std::is_x86_feature_detected!("avx512f")
+            && std::is_x86_feature_detected!("avx512vl")
+            && std::is_x86_feature_detected!("avx512dq")
+            && std::is_x86_feature_detected!("avx512bw")
             && std::is_x86_feature_detected!("avx2")
             && std::is_x86_feature_detected!("fma")
         {
-            // SAFETY: the CPU has AVX-512F, AVX2 and FMA.
+            // SAFETY: the CPU has AVX-512 F/VL/DQ/BW, AVX2 and FMA.
             unsafe { avx512() };
         }
     }
