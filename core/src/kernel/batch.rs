@@ -106,8 +106,9 @@ pub(crate) trait LaneOp<T> {
 
     /// Whether the AVX-512 build of the loop also enables AVX-512 VL, DQ and BW (which
     /// [`IsaKind::Avx512`] guarantees): eight-lane rows then have 32 registers and k-masked
-    /// moves. On for the particle transfers (AMD Zen 4: the force differential's apply about
-    /// 15 % faster); off for the kernels, whose 2D f64 batch measured slower with it.
+    /// moves. On for P2G and the force differential (AMD Zen 4: the apply about 15 % faster);
+    /// off for the kernels, whose 2D f64 batch measured slower with it. G2P runs its AVX2
+    /// build under AVX-512 (see `g2p_update`).
     const AVX512_VL: bool = false;
 }
 

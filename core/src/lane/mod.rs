@@ -7,8 +7,8 @@
 //! - on one `f32` or `f64` ([`Lane`] is implemented for every [`Real`]): the single-particle
 //!   API, and the only form on targets without SIMD (`no_std`, `thumbv7em-none-eabihf`);
 //! - on x86-64 vectors (`x86` module, crate-private): `f32×8`/`f64×4` with AVX2+FMA and
-//!   `f32×16`/`f64×8` with AVX-512 (F, VL, DQ, BW). They are reachable only through the batch entry points
-//!   of [`crate::kernel`], which take an [`Isa`] that proves the CPU supports them.
+//!   `f32×16`/`f64×8` with AVX-512 (F, VL, DQ, BW). They are reachable only through the batch
+//!   entry points of [`crate::kernel`], which take an [`Isa`] that proves the CPU supports them.
 //!
 //! **Bits.** The vector paths use only operations that round the same way on AVX2 and
 //! AVX-512: `+ − × ÷`, `sqrt`, `floor`, the fused [`Lane::mul_add`] (one rounding), and exact
@@ -333,10 +333,9 @@ pub enum IsaKind {
     Scalar,
     /// x86-64 AVX2 + FMA: `f32×8`, `f64×4`.
     Avx2,
-    /// x86-64 AVX-512 F, VL, DQ and BW (+ AVX2 + FMA): `f32×16`, `f64×8`. VL lets the
-    /// eight-lane rows of the particle transfers use 32 registers and masked moves that
-    /// are not microcoded (AMD Zen 4: the force differential's apply about 15 % faster than
-    /// with AVX-512F alone, measured in one run).
+    /// x86-64 AVX-512 F, VL, DQ and BW (+ AVX2 + FMA): `f32×16`, `f64×8`. The particle
+    /// transfers' eight-lane rows are built with VL (32 registers, k-masked moves; see
+    /// `LaneOp::AVX512_VL`), the kernels with AVX-512F alone.
     Avx512,
 }
 

@@ -132,8 +132,6 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    const AVX512_VL: bool = true;
-
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
         // `dispatch` calls `run_rows`; this is its scalar-row form.
