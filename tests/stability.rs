@@ -1,5 +1,5 @@
 //! Stability contracts of every polar/SVD method × dim × precision on every family of `F`
-//! (`tools/src/families.rs`), against the double-double reference (`tools/src/reference.rs`);
+//! (`tools/src/families/`), against the double-double reference (`tools/src/reference.rs`);
 //! the reference itself; scale invariance; bounded iteration; and the run-time method choice
 //! of the C ABI (`ffi/src/methods.rs`).
 //!

@@ -189,7 +189,7 @@ pub(crate) fn none<V: Lane>() -> V::Mask {
     V::splat(<V::Scalar as Real>::ONE).lt(V::splat(<V::Scalar as Real>::ZERO))
 }
 
-/// The check masks of [`evaluate`] as bit sets with their statuses, in order of precedence.
+/// The check masks of [`super::evaluate`] as bit sets with their statuses, in order of precedence.
 #[inline(always)]
 pub(crate) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u32, Error); 5] {
     [

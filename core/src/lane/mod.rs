@@ -321,7 +321,7 @@ impl<T: Real> Lane for T {
 }
 
 /// The instruction sets of the batch kernels, widest first. A value other than
-/// [`Isa::Scalar`] is a promise that the CPU supports it: create it with [`Isa::detect`] (with
+/// [`Isa::SCALAR`] is a promise that the CPU supports it: create it with `Isa::detect` (with
 /// the `std` feature) or, unsafely, with [`Isa::assume`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Isa(IsaKind);

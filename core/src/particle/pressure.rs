@@ -12,7 +12,8 @@ use crate::scalar::Real;
 /// The particle pressure `p = −Ψ_λ'(J_E)/J_P` (Pa) with the particle's (hardened) `λ`
 /// ([`dilation::pressure`]).
 ///
-/// Errors: invalid material or particle; [`Error::InvalidArgument`] when `1/λ = 0`.
+/// Errors: invalid material or particle;
+/// [`Error::InvalidArgument`](crate::Error::InvalidArgument) when `1/λ = 0`.
 #[inline]
 pub fn pressure<T: Real, const D: usize>(material: &Material<T>, p: &Particle<T, D>) -> Result<T>
 where

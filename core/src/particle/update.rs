@@ -387,7 +387,7 @@ fn check_temperature<T: Real, const D: usize>(
 ///    phase change the heat `q = c (T* − T_p)` goes through the latent buffer and may switch
 ///    the phase ([`thermal::absorb`]);
 /// 2. APIC: `v_p ← s.v`, `C_p ← s.affine`, `x_p ← x_p + Δt v_p`;
-/// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`]);
+/// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`](super::deformation::evolve));
 /// 4. a liquid keeps its volume ratios only ([`liquid_projection`]: `F_E ← J_E^{1/d} I`,
 ///    `F_P ← J_P^{1/d} I`); a solid with snow plasticity clamps ([`snow_plasticity`]); an
 ///    elastic solid does neither.

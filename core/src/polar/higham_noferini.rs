@@ -29,7 +29,7 @@
 //! stable, so the eigenvector has the error `O(ε‖B‖/gap) = O(ε‖F‖/(σ₁+σ₂))` that the
 //! conditioning allows, with no special cases for nearly repeated or zero eigenvalues — at the
 //! price of speed: at most 6 sweeps of 6 rotations on the 4×4 were needed over every family of
-//! `tools/src/families.rs` (4 suffice for all but ~10 % in f64), then a 3×3 Jacobi for `V`;
+//! `tools/src/families/` (4 suffice for all but ~10 % in f64), then a 3×3 Jacobi for `V`;
 //! about twice the time of one-sided Jacobi.
 //!
 //! **Then Σ and V** (so that the method serves the fixed corotated energy, which needs `σᵢ` and

@@ -21,7 +21,7 @@
 //!    of `det F` — the rotation-variant convention of [`crate::polar`].
 //!
 //! Every data-dependent choice is a select, so the same source runs on SIMD lanes
-//! ([`crate::batch`]) and gives, lane by lane, the bits of this scalar method.
+//! ([`crate::kernel::batch`]) and gives, lane by lane, the bits of this scalar method.
 //!
 //! **Accuracy.** Working on `FᵀF` squares the condition number: the eigenvalues `σᵢ²` are
 //! found to absolute accuracy `~ε σ₀²`, so `σ_min` has relative error `~ε (σ_max/σ_min)²`
@@ -212,7 +212,7 @@ impl McAdams {
     /// The SVD of each lane of `f0` (finite input): `(U, σ, V)`, column-major lane matrices.
     ///
     /// One generic source for one scalar (`S = f32`, `f64`, behind [`SvdMethod`]) and for
-    /// `N` lanes ([`crate::batch`]).
+    /// `N` lanes ([`crate::kernel::batch`]).
     #[inline(always)]
     #[must_use]
     pub fn svd_lanes<S: Lane>(&self, f0: &LMat<S, 3>) -> (LMat<S, 3>, [S; 3], LMat<S, 3>) {

@@ -29,7 +29,7 @@
 //! perturbation bound `‖ΔR‖_F ≤ 2‖ΔF‖_F/(σ_{d−1}+σ_d)`, R.-C. Li 1995), whatever the scale.
 //!
 //! **Iteration cap.** Each sweep reduces the last off-diagonal `β₁` cubically once it is small
-//! (Wilkinson shift): over every family of `tools/src/families.rs` (about 30 000 matrices per
+//! (Wilkinson shift): over every family of `tools/src/families/` (about 30 000 matrices per
 //! precision) the largest number of sweeps needed is 6 in f64 and 5 in f32, against the
 //! default cap of 32. The method returns
 //! [`Error::NotConverged`] only if both `β` are still above the tolerance after

@@ -2,6 +2,8 @@
 //! update from it, the implicit force differential (prepare, apply), stencils and pressures.
 //! The types' docs are the header's documentation of layouts, units and rules.
 #![allow(clippy::missing_safety_doc, clippy::too_many_arguments)]
+// The docs are the header's C text (`lo[a]`, `stride[0]`), not rustdoc links.
+#![allow(rustdoc::broken_intra_doc_links)]
 
 pub(crate) mod imp;
 

@@ -7,8 +7,9 @@
 //! into such a function, LLVM emits the vector instructions directly.
 //!
 //! Every operation is the IEEE-754 operation of the scalar instantiation (see the module
-//! docs of [`crate::lane`]): `vfmadd` rounds once, `vsqrt`/`vdiv` are correctly rounded, `floor` is `vround`/`vrndscale` toward
-//! −∞, [`Lane::exponent`] and [`Lane::pow2`] are exact.
+//! docs of [`crate::lane`]): `vfmadd` rounds once, `vsqrt`/`vdiv` are correctly rounded,
+//! `floor` is `vround`/`vrndscale` toward −∞, [`Lane::exponent`](crate::lane::Lane::exponent)
+//! and [`Lane::pow2`](crate::lane::Lane::pow2) are exact.
 
 #![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 
