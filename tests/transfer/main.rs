@@ -18,12 +18,16 @@
 //!    option `⟨δu, K δu⟩ ≤ 0` for every `δu`, including a dilational part that is indefinite,
 //!    and it equals the exact differential where that is already definite; unprepared slots
 //!    are refused.
+//! 5. `layouts`: G2P and the force differential give the same bits on separate node arrays,
+//!    interleaved node structs and arrays of different strides (the read paths of the node
+//!    sums), and the same bits on every vector instruction set.
 //!
 //! This file holds what the modules share: the dense test grid, the particle arrays, and the
 //! materials and particles the tests run.
 mod failures;
 mod force;
 mod g2p;
+mod layouts;
 mod p2g;
 
 use ampm_core::particle::transfer::g2p::G2pView;

@@ -8,10 +8,8 @@
 //! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
 //! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
 
-use super::nodes::NodeVals;
-use super::nodes::{
-    add, node_sums, nodes, read, rel_base, restore, row_consts, rows, table, with_nodes,
-};
+use super::field_sums::node_field_sums;
+use super::nodes::{add, nodes, rel_base, restore, table, with_nodes};
 use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use super::OutChannel;
 use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
@@ -310,7 +308,6 @@ where
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
-        let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
         let mut tile = Tile::<R, D>::new();
         let mut run = [0usize; MAX_RUN];
@@ -337,7 +334,6 @@ where
                         start + k,
                         &xs[k],
                         done >> k & 1 == 1,
-                        &cst,
                         &mut stencils[k],
                         &mut rels[k],
                         &mut gs[k],
@@ -368,7 +364,6 @@ where
                             (&stencils[k], &rels[k], &ms[k]),
                             &mut tile,
                             (&mut run, &mut nrun),
-                            &cst,
                             &mut first,
                         )
                     };
@@ -377,7 +372,7 @@ where
             start += len;
         }
         // SAFETY: as above.
-        unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &cst, &mut first) };
+        unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &mut first) };
         first.status()
     }
 
@@ -393,7 +388,6 @@ where
         (s, rel, m): (&Stencil<T, D>, &[isize; D], &Mat<T, D>),
         tile: &mut Tile<R, D>,
         (run, nrun): (&mut [usize; MAX_RUN], &mut usize),
-        cst: &[[T; 8]; N],
         first: &mut FirstFailure,
     ) {
         let fits = if *nrun < MAX_RUN {
@@ -404,7 +398,7 @@ where
         let sp = match fits {
             Some(sp) => sp,
             None => {
-                self.flush::<R, K, N>(tile, &run[..*nrun], cst, first);
+                self.flush::<R, K, N>(tile, &run[..*nrun], first);
                 *nrun = 0;
                 // An empty tile takes any stencil.
                 tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
@@ -428,12 +422,11 @@ where
     unsafe fn gather<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
         i: usize,
-        cst: &[[T; 8]; N],
     ) -> Result<(Stencil<T, D>, [isize; D], Mat<T, D>)> {
         let xp = rd_vec::<T, D>(self.x, i);
         let mut s = Stencil::blank(self.kernel, self.h);
         let (mut rel, mut g) = ([0; D], Mat::ZERO);
-        self.gather_with::<R, K, N>(i, &xp, false, cst, &mut s, &mut rel, &mut g)?;
+        self.gather_with::<R, K, N>(i, &xp, false, &mut s, &mut rel, &mut g)?;
         Ok((s, rel, apply_slot(self.slot(i), &g)))
     }
 
@@ -461,7 +454,6 @@ where
         i: usize,
         xp: &[T; D],
         lane: bool,
-        cst: &[[T; 8]; N],
         s: &mut Stencil<T, D>,
         rel: &mut [isize; D],
         g: &mut Mat<T, D>,
@@ -473,7 +465,7 @@ where
             *s = Stencil::new(self.kernel, Grid::Collocated, self.h, xp)?;
         }
         *rel = rel_base(s, &self.view.nodes)?;
-        *g = grad_u::<T, R, D, K, N>(s, rel, self.view, cst)?;
+        *g = grad_u::<T, R, D, K, N>(s, rel, self.view)?;
         Ok(())
     }
 
@@ -487,7 +479,6 @@ where
         &self,
         tile: &mut Tile<R, D>,
         run: &[usize],
-        cst: &[[T; 8]; N],
         first: &mut FirstFailure,
     ) {
         if tile.add_to_grid::<K>(&self.view.df) {
@@ -495,7 +486,7 @@ where
         }
         for &i in run {
             let r = self
-                .gather::<R, K, N>(i, cst)
+                .gather::<R, K, N>(i)
                 .and_then(|(s, rel, m)| one::<T, D, K, N>(&s, &rel, &m, self.view));
             first.note(i, r);
         }
@@ -538,7 +529,8 @@ unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
     }
 }
 
-/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`), by [`node_sums`].
+/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`), by the
+/// separable contraction of [`node_field_sums`].
 ///
 /// # Safety
 /// `apply`'s contract; the stencil is inside the box.
@@ -547,29 +539,12 @@ unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     s: &Stencil<T, D>,
     rel: &[isize; D],
     view: &ForceView<T, D>,
-    cst: &[[T; 8]; N],
 ) -> Result<Mat<T, D>> {
-    let mut u = [NodeVals::<T, N>::new(); D];
-    let mut chk = true;
-    for a in 0..D {
-        let c = &view.du[a];
-        chk &= read::<T, R, D, K, N>(c.data, &table(c, rel), c.stride[0], &mut u[a]);
-    }
-    if !chk {
+    let sums = node_field_sums::<T, R, D, K, false>(s, rel, &view.du, (0, D));
+    if !sums.finite {
         return Err(Error::NonFinite);
     }
-    // G row by row: lanes 1 + d + b of Σ_j δu_{a,j} m_j are Σ_j δu_{a,j} ∂w_j/∂x_b.
-    let m = rows::<T, R, D, K, N>(s, cst);
-    let sum = node_sums::<T, R, D, K, N>(&m, &u, (0, D));
-    let mut g = Mat::<T, D>::ZERO;
-    for a in 0..D {
-        let mut l = [T::ZERO; 8];
-        sum[a].store(&mut l);
-        for b in 0..D {
-            g.cols[b][a] = l[1 + D + b];
-        }
-    }
-    Ok(g)
+    Ok(sums.g)
 }
 
 /// One particle of [`apply`] added on its own: `δf_i = M ∇w_i` added per channel, with every

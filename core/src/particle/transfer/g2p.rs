@@ -10,9 +10,8 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::nodes::{
-    node_sums, read, rel_base, row_consts, rows, table, taint, with_nodes, NodeVals,
-};
+use super::field_sums::{node_field_sums, Sums};
+use super::nodes::{nodes, read, rel_base, table, taint, with_nodes, NodeVals};
 use super::update_lanes::{self, ChunkSamples};
 use super::{chunk_stencils, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
@@ -157,7 +156,6 @@ where
     /// are those of the one-particle order: the particle's own checks come before its sample's.
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
-        let cst = row_consts::<T, D, K, N>();
         let mut first = FirstFailure::new(self.n);
         // Chunks of elastic solids or of liquids (after their heat step) are updated on the row
         // type's eight lanes.
@@ -216,7 +214,6 @@ where
                             &stencils[k],
                             self.view,
                             self.faces,
-                            &cst,
                             out,
                         )
                     };
@@ -302,52 +299,9 @@ where
     Ok(())
 }
 
-/// Sums over the velocity channels of one stencil (components `comps`): per component
-/// `Σ w v`, `Σ w v oᵀ`, `Σ v ∇wᵀ`, and whether every value read was finite. The `1 + 2d`
-/// sums of a component are one short vector `Σ_i v_i m_i` over the node rows `m` of [`rows`]
-/// ([`node_sums`]).
-#[inline(always)]
-unsafe fn sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
-    m: &[R; N],
-    rel: &[isize; D],
-    ch: &[InChannel<T, D>; D],
-    comps: (usize, usize),
-) -> ([T; D], [[T; D]; D], [[T; D]; D], bool) {
-    let mut q = [NodeVals::<T, N>::new(); D];
-    let mut chk = true;
-    // Loops over all `d` components with a test (a fixed trip count the compiler unrolls).
-    let on = |a: usize| comps.0 <= a && a < comps.1;
-    for a in 0..D {
-        if !on(a) {
-            continue;
-        }
-        let t = table(&ch[a], rel);
-        chk &= read::<T, R, D, K, N>(ch[a].data, &t, ch[a].stride[0], &mut q[a]);
-    }
-    let sum = node_sums::<T, R, D, K, N>(m, &q, comps);
-    let mut acc = [[T::ZERO; 8]; D];
-    for a in 0..D {
-        sum[a].store(&mut acc[a]);
-    }
-    let mut v = [T::ZERO; D];
-    let mut so = [[T::ZERO; D]; D];
-    let mut g = [[T::ZERO; D]; D];
-    for a in 0..D {
-        if !on(a) {
-            continue;
-        }
-        v[a] = acc[a][0];
-        for b in 0..D {
-            so[a][b] = acc[a][1 + b];
-            g[a][b] = acc[a][1 + D + b];
-        }
-    }
-    (v, so, g, chk)
-}
-
 /// `Σ w Tⁿ⁺¹` and `Σ w (Tⁿ⁺¹ − Tⁿ)` (the node difference is exact when the two are within a
-/// factor 2, Sterbenz), and whether every value read was finite; `w` is column 0 of the node
-/// rows `m` of [`rows`].
+/// factor 2, Sterbenz), and whether every value read was finite; `w` the node weights of
+/// stencil `s` ([`nodes`]).
 #[inline(always)]
 unsafe fn temperatures<
     T: Real,
@@ -356,7 +310,7 @@ unsafe fn temperatures<
     const K: usize,
     const N: usize,
 >(
-    m: &[R; N],
+    s: &Stencil<T, D>,
     rel: &[isize; D],
     new: &InChannel<T, D>,
     old: &InChannel<T, D>,
@@ -364,13 +318,7 @@ unsafe fn temperatures<
     let (mut tn, mut to) = (NodeVals::<T, N>::new(), NodeVals::<T, N>::new());
     let mut chk = read::<T, R, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
     chk &= read::<T, R, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
-    // Lane 0 of each row is the weight: lane 0 sums Σ w Tⁿ⁺¹, lane 1 Σ w (Tⁿ⁺¹ − Tⁿ).
-    let mut w = [T::ZERO; N];
-    for i in 0..N {
-        let mut l = [T::ZERO; 8];
-        m[i].store(&mut l);
-        w[i] = l[0];
-    }
+    let w = nodes::<T, D, K, N>(s).w;
     let (mut pic, mut flip) = (T::ZERO, T::ZERO);
     for i in 0..N {
         pic += w[i] * tn.v[i];
@@ -390,7 +338,6 @@ unsafe fn sample<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     s: &Stencil<T, D>,
     view: &G2pView<T, D>,
     faces: Option<&[G2pView<T, D>; D]>,
-    cst: &[[T; 8]; N],
     out: &mut G2pSample<T, D>,
 ) -> Result<()>
 where
@@ -410,37 +357,34 @@ where
     out.t_pic = T::ZERO;
     out.t_flip = T::ZERO;
     let mut finite = true;
-    let mut put = |a: usize, st: &Stencil<T, D>, v: &[T; D], so: &[[T; D]; D], g: &[[T; D]; D]| {
-        out.v[a] = v[a];
+    let mut put = |a: usize, st: &Stencil<T, D>, sm: &Sums<T, D>| {
+        out.v[a] = sm.v[a];
         for b in 0..D {
-            out.affine.cols[b][a] = (so[a][b] - v[a] * st.fx[b]) * inv_kh;
-            out.grad_v.cols[b][a] = g[a][b];
+            out.affine.cols[b][a] = (sm.mo.cols[b][a] - sm.v[a] * st.fx[b]) * inv_kh;
+            out.grad_v.cols[b][a] = sm.g.cols[b][a];
         }
     };
-    // The collocated stencil's nodes, once for its velocities and temperatures.
-    let m = rows::<T, R, D, K, N>(s, cst);
     match faces {
         None => {
-            let (v, so, g, ok) = sums::<T, R, D, K, N>(&m, &rel, &view.velocity, (0, D));
-            finite &= ok;
+            let sm = node_field_sums::<T, R, D, K, true>(s, &rel, &view.velocity, (0, D));
+            finite &= sm.finite;
             for a in 0..D {
-                put(a, s, &v, &so, &g);
+                put(a, s, &sm);
             }
         }
         Some(f) => {
             for a in 0..D {
                 let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
                 let rl = rel_base(&st, &f[a].nodes)?;
-                let mf = rows::<T, R, D, K, N>(&st, cst);
-                let (v, so, g, ok) = sums::<T, R, D, K, N>(&mf, &rl, &f[a].velocity, (a, a + 1));
-                finite &= ok;
-                put(a, &st, &v, &so, &g);
+                let sm = node_field_sums::<T, R, D, K, true>(&st, &rl, &f[a].velocity, (a, a + 1));
+                finite &= sm.finite;
+                put(a, &st, &sm);
             }
         }
     }
     if material.heat.is_some() {
         let (pic, flip, ok) =
-            temperatures::<T, R, D, K, N>(&m, &rel, &view.temperature, &view.temperature_old);
+            temperatures::<T, R, D, K, N>(s, &rel, &view.temperature, &view.temperature_old);
         finite &= ok;
         out.t_pic = pic;
         out.t_flip = flip;

@@ -109,49 +109,6 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
     nd
 }
 
-/// The node rows of a stencil for sums over its nodes, as eight-lane vectors `R`:
-/// `m_i = [w, w o₀, …, w o_{d−1}, ∂w/∂x₀, …, ∂w/∂x_{d−1}, 0…]` for node `i` (the products
-/// of [`Nodes`]; `w o` is exact for the offsets 0, 1, 2 of the quadratic kernel).
-/// `Σ_i v_i m_i` then gives the `1 + 2d` sums of a node value `v` with one vector
-/// multiply-add per node ([`node_sums`]). Each row is the product of a factor of its axis-0
-/// offset, `[w₀, w₀…, dw₀, w₀…]`, one of its stencil row, `[c₀, c₀…, c₀, c₁…]`, and a
-/// constant of [`row_consts`] (`cst`, which also zeroes the unused lanes). The factors are
-/// put together in registers by lane selects: lanes stored one scalar at a time and then
-/// loaded as a vector would wait for the stores to reach the cache (no store forwarding).
-#[inline(always)]
-pub(crate) fn rows<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
-    s: &Stencil<T, D>,
-    cst: &[[T; 8]; N],
-) -> [R; N] {
-    debug_assert_eq!(R::LANES, 8);
-    let (w, dw) = (&s.w, &s.dw);
-    let idx = lane_index::<T, R>();
-    let mut lane_is = [idx.eq(R::splat(T::ZERO)); ROW_LANES];
-    for (l, x) in lane_is.iter_mut().enumerate() {
-        *x = idx.eq(R::splat(T::from_i32(l as i32)));
-    }
-    // Per axis-0 offset: dw₀ in lane 1 + d, w₀ elsewhere.
-    let grad0 = lane_is[1 + D];
-    let mut f0 = [R::splat(T::ZERO); K];
-    for (o0, f) in f0.iter_mut().enumerate() {
-        *f = R::select(grad0, R::splat(dw[0][o0]), R::splat(w[0][o0]));
-    }
-    let mut m = [R::splat(T::ZERO); N];
-    for r in 0..N / K {
-        let c = row_factors::<T, D, K, N>(s, r);
-        // c_b in lane 1 + d + b (b ≥ 1), c₀ elsewhere.
-        let mut fr = R::splat(c[0]);
-        for (b, &cb) in c.iter().enumerate().skip(1) {
-            fr = R::select(lane_is[1 + D + b], R::splat(cb), fr);
-        }
-        for o0 in 0..K {
-            let i = r * K + o0;
-            m[i] = f0[o0] * fr * R::load(&cst[i]);
-        }
-    }
-    m
-}
-
 /// The lane indices `[0, 1, …, 7]` as scalars (a constant vector).
 #[inline(always)]
 pub(crate) fn lane_index<T: Real, R: Lane<Scalar = T>>() -> R {
@@ -160,59 +117,6 @@ pub(crate) fn lane_index<T: Real, R: Lane<Scalar = T>>() -> R {
         *x = T::from_i32(i as i32);
     }
     R::load(&l)
-}
-
-/// `Σ_i v_{a,i} m_i` over the `N = K^d` node rows `m` of [`rows`], for the components
-/// `a ∈ comps.0..comps.1` of the node values `v` (the others are zero). Each component keeps
-/// `K` partial sums, one per axis-0 offset, added at the end: a single running sum would make
-/// every node's multiply-add wait for the previous one's (`N` latencies in a row).
-#[inline(always)]
-pub(crate) fn node_sums<
-    T: Real,
-    R: Lane<Scalar = T>,
-    const D: usize,
-    const K: usize,
-    const N: usize,
->(
-    m: &[R; N],
-    v: &[NodeVals<T, N>; D],
-    comps: (usize, usize),
-) -> [R; D] {
-    let z = R::splat(T::ZERO);
-    let mut part = [[z; K]; D];
-    for r in 0..N / K {
-        for o0 in 0..K {
-            let i = r * K + o0;
-            for a in 0..D {
-                if comps.0 <= a && a < comps.1 {
-                    part[a][o0] = R::splat(v[a].v[i]).mul_add(m[i], part[a][o0]);
-                }
-            }
-        }
-    }
-    let mut sum = [z; D];
-    for a in 0..D {
-        for p in part[a] {
-            sum[a] += p;
-        }
-    }
-    sum
-}
-
-/// The constant factors of [`rows`]: `[1, o₀, …, o_{d−1}, 1…, 0…]` per node.
-#[inline(always)]
-pub(crate) fn row_consts<T: Real, const D: usize, const K: usize, const N: usize>() -> [[T; 8]; N] {
-    let c = [T::ZERO, T::ONE, T::TWO, T::from_i32(3)];
-    let mut m = [[T::ZERO; 8]; N];
-    for (i, mi) in m.iter_mut().enumerate() {
-        let o = Offsets::<D, K, N>::O[i];
-        mi[0] = T::ONE;
-        for a in 0..D {
-            mi[1 + a] = c[o[a]];
-            mi[1 + D + a] = T::ONE;
-        }
-    }
-    m
 }
 
 /// Evaluates `body` with the constants `K` (nodes per axis of `kernel`) and `N = K^d` (nodes

@@ -1,0 +1,283 @@
+//! Sums over a stencil's nodes of a node vector field by separable contraction: the gradient
+//! `G = Σ_i u_i ∇w_iᵀ` (the force differential's `δu`) and, for G2P, also `Σ_i w_i v_i` and
+//! the moments `Σ_i w_i v_i o_iᵀ` (`o` the node offset from the stencil base).
+//!
+//! With the tensor-product weights `w_i = Π_a w_a[o_a]` and `∂w_i/∂x_b` the same product with
+//! `dw_b` for `w_b` ([`Stencil`]), each sum factors axis by axis (3D; 2D drops the `o₂` level):
+//!
+//! `S[o₀](o₂) = Σ_{o₁} w₁[o₁] u(o₀, o₁, o₂)`, `S'` with `dw₁`, `S°` with `w₁[o₁] o₁`;
+//! `A₀[o₀] = Σ_{o₂} w₂ S`, `A₁ = Σ_{o₂} w₂ S'`, `A₂ = Σ_{o₂} dw₂ S`, `A₃ = Σ_{o₂} w₂ S°`,
+//! `A₄ = Σ_{o₂} w₂ o₂ S`;
+//!
+//! `G_{a0} = Σ_{o₀} dw₀ A₀`, `G_{ab} = Σ_{o₀} w₀ A_b` (`b ≥ 1`), `Σ w v = Σ_{o₀} w₀ A₀`, and the
+//! moments `Σ_{o₀} w₀ o₀ A₀`, `Σ_{o₀} w₀ A₃`, `Σ_{o₀} w₀ A₄`, per component `a` of `u`. The
+//! gradient alone costs `2K^{d−1} + d K^{d−2}` multiply-adds per component and axis-0 offset in
+//! 3D and `2K` in 2D, about the `d K^{d−1}` of the node-by-node sum, but no per-node weight is
+//! formed and few lanes below carry a sum that is not used. Terms with a zero offset factor
+//! (`o = 0`) are skipped: they add `±0` to a finite sum.
+//!
+//! **Lanes.** A node row (the `K ≤ 4` nodes that differ in axis 0 only) of every component is
+//! read into eight-lane vectors: component `a` in vector `a / 2`, lanes `4 (a mod 2) + o₀`, the
+//! other lanes 0. Each multiply-add of the contraction above then runs for two components'
+//! `K` axis-0 offsets at once, and the last level is one product per vector followed by sums of
+//! `K` lanes. Every lane's operations, in order, are the same on every eight-lane row type, so
+//! AVX2 and AVX-512 give the same bits.
+
+use super::InChannel;
+use crate::lane::Lane;
+use crate::mat::Mat;
+use crate::particle::stencil::Stencil;
+use crate::scalar::Real;
+
+/// Lanes of the row vectors.
+const LANES: usize = 8;
+/// Lanes per component in a row vector.
+const SLOT: usize = 4;
+
+/// The sums of one node vector field over a stencil, per component `a` (rows of [`Mat`] as
+/// in `Mat::cols[b][a]`).
+pub(crate) struct Sums<T, const D: usize> {
+    /// `Σ_i w_i u_{a,i}` (with `FULL`).
+    pub v: [T; D],
+    /// `mo.cols[b][a] = Σ_i w_i u_{a,i} o_{i,b}` (with `FULL`).
+    pub mo: Mat<T, D>,
+    /// `g.cols[b][a] = Σ_i u_{a,i} ∂w_i/∂x_b`.
+    pub g: Mat<T, D>,
+    /// Every value read is finite.
+    pub finite: bool,
+}
+
+/// The [`Sums`] over the `N = K^d` nodes of stencil `s` (`K ≤ 4`, `d` 2 or 3) of the components
+/// `a ∈ comps.0..comps.1` read from `ch[a]` at box-relative base `rel` (the others 0, not
+/// read); `FULL`: also `Σ w u` and the moments, else only `g`.
+///
+/// # Safety
+/// Every stencil node is inside the box of each channel read (checked by `rel_base`).
+#[inline(always)]
+pub(crate) unsafe fn node_field_sums<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const FULL: bool,
+>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
+    ch: &[InChannel<T, D>; D],
+    comps: (usize, usize),
+) -> Sums<T, D> {
+    debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
+    let z = R::splat(T::ZERO);
+    let sp = R::splat;
+    let (w, dw) = (&s.w, &s.dw);
+    let pv = D.div_ceil(2);
+    // Separate node arrays of one box (the usual layout) share their strides: one row offset
+    // for every component, and whole-row loads.
+    let on = |a: usize| comps.0 <= a && a < comps.1;
+    let mut same = true;
+    for (a, c) in ch.iter().enumerate() {
+        same &= !on(a) || (c.stride == ch[comps.0].stride && c.stride[0] == 1);
+    }
+    let (acc, finite) = if same {
+        contract::<T, R, D, K, true, FULL>(ch, rel, s, comps)
+    } else {
+        contract::<T, R, D, K, false, FULL>(ch, rel, s, comps)
+    };
+    // Axis 0: the factors in the lanes of their offsets (lane selects, not a vector load of
+    // scalars just stored, which the store buffer could not forward).
+    let mut idx = [T::ZERO; LANES];
+    for (l, x) in idx.iter_mut().enumerate() {
+        *x = T::from_i32((l % SLOT) as i32);
+    }
+    let idx = R::load(&idx);
+    let (mut f_w, mut f_dw, mut f_wo) = (z, z, z);
+    for o0 in 0..K {
+        let m = idx.eq(sp(T::from_i32(o0 as i32)));
+        f_w = R::select(m, sp(w[0][o0]), f_w);
+        f_dw = R::select(m, sp(dw[0][o0]), f_dw);
+        f_wo = R::select(m, sp(w[0][o0] * T::from_i32(o0 as i32)), f_wo);
+    }
+    let mut out = Sums {
+        v: [T::ZERO; D],
+        mo: Mat::ZERO,
+        g: Mat::ZERO,
+        finite,
+    };
+    let mut l = [[[T::ZERO; LANES]; 2]; 8];
+    let mut f = [z; 8];
+    // (acc index, factor) per output: g₀, g₁, g₂, then with FULL Σ w u, moments 0, 1, 2.
+    let mut k = [0usize; 8];
+    let mut nq = 0;
+    for b in 0..D {
+        k[nq] = b;
+        f[nq] = if b == 0 { f_dw } else { f_w };
+        nq += 1;
+    }
+    if FULL {
+        k[nq] = 0;
+        f[nq] = f_w;
+        nq += 1;
+        k[nq] = 0;
+        f[nq] = f_wo;
+        nq += 1;
+        for b in 1..D {
+            k[nq] = 2 + b;
+            f[nq] = f_w;
+            nq += 1;
+        }
+    }
+    for q in 0..nq {
+        for j in 0..pv {
+            (acc[k[q]][j] * f[q]).store(&mut l[q][j]);
+        }
+    }
+    for q in 0..nq {
+        for a in 0..D {
+            if !on(a) {
+                continue;
+            }
+            let lanes = &l[q][a / 2][SLOT * (a % 2)..];
+            let mut sum = lanes[0];
+            for x in &lanes[1..K] {
+                sum += *x;
+            }
+            match q {
+                _ if q < D => out.g.cols[q][a] = sum,
+                _ if q == D => out.v[a] = sum,
+                _ => out.mo.cols[q - D - 1][a] = sum,
+            }
+        }
+    }
+    out
+}
+
+/// The sums `A_k` of the module docs as packed vectors (`acc[k][j]`, vector `j`; `A₃`, `A₄`
+/// with `FULL`), and whether every value read is finite. `SAME`: every channel read has unit
+/// axis-0 stride and the strides of channel `comps.0`.
+///
+/// # Safety
+/// As [`node_field_sums`].
+#[inline(always)]
+unsafe fn contract<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const SAME: bool,
+    const FULL: bool,
+>(
+    ch: &[InChannel<T, D>; D],
+    rel: &[isize; D],
+    s: &Stencil<T, D>,
+    comps: (usize, usize),
+) -> ([[R; 2]; 5], bool) {
+    let z = R::splat(T::ZERO);
+    let sp = R::splat;
+    let (w, dw) = (&s.w, &s.dw);
+    let pv = D.div_ceil(2);
+    let o = |i: usize| T::from_i32(i as i32);
+    // The stencil's first node in each channel read.
+    let mut p = [core::ptr::null::<T>(); D];
+    for (a, pa) in p.iter_mut().enumerate() {
+        if comps.0 <= a && a < comps.1 {
+            let mut off = 0;
+            for b in 0..D {
+                off += rel[b] * ch[a].stride[b];
+            }
+            *pa = ch[a].data.offset(off);
+        }
+    }
+    // Σ x·0 over every vector read: NaN exactly when some value read is not finite (one
+    // multiply-add per vector instead of a compare and a mask test).
+    let mut chk = [z; 2];
+    let mut acc = [[z; 2]; 5];
+    if D == 2 {
+        for o1 in 0..K {
+            let u = row::<T, R, D, K, SAME>(ch, &p, [o1, 0], comps);
+            for j in 0..pv {
+                chk[j] = u[j].mul_add(z, chk[j]);
+                acc[0][j] = u[j].mul_add(sp(w[1][o1]), acc[0][j]);
+                acc[1][j] = u[j].mul_add(sp(dw[1][o1]), acc[1][j]);
+                if FULL && o1 > 0 {
+                    acc[3][j] = u[j].mul_add(sp(w[1][o1] * o(o1)), acc[3][j]);
+                }
+            }
+        }
+    } else {
+        for o2 in 0..K {
+            let (mut sw, mut sd, mut so) = ([z; 2], [z; 2], [z; 2]);
+            for o1 in 0..K {
+                let u = row::<T, R, D, K, SAME>(ch, &p, [o1, o2], comps);
+                for j in 0..pv {
+                    chk[j] = u[j].mul_add(z, chk[j]);
+                    sw[j] = u[j].mul_add(sp(w[1][o1]), sw[j]);
+                    sd[j] = u[j].mul_add(sp(dw[1][o1]), sd[j]);
+                    if FULL && o1 > 0 {
+                        so[j] = u[j].mul_add(sp(w[1][o1] * o(o1)), so[j]);
+                    }
+                }
+            }
+            // Axis 2 is `D - 1` (3D here); indexing by it keeps the 2D build in bounds.
+            let (w2, dw2) = (w[D - 1][o2], dw[D - 1][o2]);
+            for j in 0..pv {
+                acc[0][j] = sw[j].mul_add(sp(w2), acc[0][j]);
+                acc[1][j] = sd[j].mul_add(sp(w2), acc[1][j]);
+                acc[2][j] = sw[j].mul_add(sp(dw2), acc[2][j]);
+                if FULL {
+                    acc[3][j] = so[j].mul_add(sp(w2), acc[3][j]);
+                    if o2 > 0 {
+                        acc[4][j] = sw[j].mul_add(sp(w2 * o(o2)), acc[4][j]);
+                    }
+                }
+            }
+        }
+    }
+    let ok = R::all((chk[0] + chk[1]).is_finite());
+    (acc, ok)
+}
+
+/// The node row with offsets `o₁ = o[0]`, `o₂ = o[1]` of the components read, packed into two
+/// vectors as in the module docs (`p` the stencil's first node per channel; `SAME` as in
+/// [`contract`]). A function rather than a closure: a closure would not inherit the
+/// instruction set's target features, and its vector intrinsics would become calls.
+///
+/// # Safety
+/// As [`node_field_sums`].
+#[inline(always)]
+unsafe fn row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const SAME: bool>(
+    ch: &[InChannel<T, D>; D],
+    p: &[*const T; D],
+    o: [usize; 2],
+    comps: (usize, usize),
+) -> [R; 2] {
+    let mut v = [R::splat(T::ZERO); 2];
+    for a in 0..D {
+        if a < comps.0 || a >= comps.1 {
+            continue;
+        }
+        let st = if SAME {
+            &ch[comps.0].stride
+        } else {
+            &ch[a].stride
+        };
+        let mut off = 0;
+        for b in 1..D {
+            off += o[b - 1] as isize * st[b];
+        }
+        let pa = p[a].offset(off);
+        let sh = SLOT * (a % 2);
+        let x = if SAME || st[0] == 1 {
+            // Lanes `sh..sh + K` from `pa[0..K]` (the other lanes are not accessed).
+            R::load_mask(pa.wrapping_sub(sh), ((1u32 << K) - 1) << sh)
+        } else {
+            let mut b = [T::ZERO; LANES];
+            for o0 in 0..K {
+                b[sh + o0] = pa.offset(o0 as isize * st[0]).read_unaligned();
+            }
+            R::load(&b)
+        };
+        // Disjoint lanes: adding zeros is exact.
+        v[a / 2] += x;
+    }
+    v
+}
