@@ -1,9 +1,10 @@
 //! G2P and the force differential read node vector fields in three layouts that take different
 //! read paths: separate arrays with shared strides (whole-row loads, one row offset for every
 //! component), interleaved node structs (strided reads), and separate arrays with different
-//! strides (whole-row loads per channel). All three give the same bits, and every vector
-//! instruction set gives the same bits as the others.
-use crate::{materials, particles, DenseGrid, Store, FORCE};
+//! strides (whole-row loads per channel), for node velocities and (with heat) node
+//! temperatures. All three give the same bits, and every vector instruction set gives the same
+//! bits as the others.
+use crate::{materials, particles, DenseGrid, Store, FORCE, TM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::kernel::{Dim, LaneDim};
 use ampm_core::lane::{Isa, IsaKind};
@@ -30,13 +31,14 @@ struct Layouts<T, const D: usize> {
 }
 
 impl<T: Real, const D: usize> Layouts<T, D> {
-    fn new(rng: &mut Pcg64, cells: i32) -> Self {
+    /// Values uniform in `[lo, hi)`.
+    fn new(rng: &mut Pcg64, cells: i32, (lo, hi): (f64, f64)) -> Self {
         let dims = [cells; D];
         let n: usize = dims.iter().map(|&d| d as usize).product();
         let sep: Vec<Vec<T>> = (0..D)
             .map(|_| {
                 (0..n)
-                    .map(|_| T::from_f64(rng.random_range(-1.0..1.0)))
+                    .map(|_| T::from_f64(rng.random_range(lo..hi)))
                     .collect()
             })
             .collect();
@@ -107,17 +109,9 @@ impl<T: Real, const D: usize> Layouts<T, D> {
     }
 }
 
-/// The bits of every particle array G2P writes.
-fn store_bits<T: Real>(s: &Store<T>) -> Vec<u64> {
-    [&s.x, &s.v, &s.affine, &s.f_e, &s.f_p]
-        .iter()
-        .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
-        .collect()
-}
-
 /// G2P and the force differential's apply on every layout and instruction set: the bits of
 /// the particle arrays (G2P) and of `δf` (apply), per instruction set and layout.
-fn run<T: BatchReal, const D: usize>(kernel: Kernel)
+fn run<T: BatchReal, const D: usize>(kernel: Kernel, material: usize)
 where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -126,25 +120,28 @@ where
 {
     let (cells, hf, n) = (13, 0.05, 37);
     let h = T::from_f64(hf);
-    let mat = materials::<T>()[0].1;
+    let (mat_name, mat) = materials::<T>()[material];
     let mut rng = Pcg64::seed_from_u64(41);
     let ps = particles::<T, D>(&mut rng, n, hf, cells - 1, &mat);
-    let field = Layouts::<T, D>::new(&mut rng, cells);
-    let name = format!("{D}D {} {kernel:?}", T::NAME);
+    let field = Layouts::<T, D>::new(&mut rng, cells, (-1.0, 1.0));
+    // Node temperatures (K) near the melting point: new in component 0, old in component 1.
+    let temps = Layouts::<T, D>::new(&mut rng, cells, (TM - 3.0, TM + 3.0));
+    let name = format!("{D}D {} {kernel:?} {mat_name}", T::NAME);
     let mut vector_bits: Option<(Isa, Vec<u64>, Vec<u64>)> = None;
     for isa in Isa::available() {
         let (mut g2p_bits, mut df_bits) = (None::<Vec<u64>>, None::<Vec<u64>>);
         for which in 0..3 {
             let label = format!("{name} {isa:?} layout {which}");
             let ch = field.channels(which);
+            let tc = temps.channels(which);
             // G2P with the field as node velocities.
             let mut store = Store::from(&ps);
             let raw = store.raw();
             let view = G2pView {
                 nodes: field.nodes,
                 velocity: ch,
-                temperature: Channel::<*const T, D>::none(),
-                temperature_old: Channel::<*const T, D>::none(),
+                temperature: tc[0],
+                temperature_old: tc[1],
             };
             let args = G2pArgs {
                 kernel,
@@ -154,7 +151,7 @@ where
             // SAFETY: n particles; the channels cover the box.
             let st = unsafe { g2p::g2p_update(isa, &mat, &args, n, &raw, &view, None) };
             assert_eq!(st.error, None, "{label}");
-            let b = store_bits(&store);
+            let b = store.bits();
             match &g2p_bits {
                 None => g2p_bits = Some(b),
                 Some(want) => assert_eq!(&b, want, "{label}: G2P"),
@@ -199,19 +196,28 @@ where
     }
 }
 
+/// Elastic (velocities only) and thermal with phase change (velocities and temperatures).
+const MATERIALS: [usize; 2] = [0, 2];
+
 #[test]
 fn layouts_and_isas_give_the_same_bits_3d_f32() {
-    run::<f32, 3>(Kernel::Quadratic);
-    run::<f32, 3>(Kernel::Cubic);
+    for m in MATERIALS {
+        run::<f32, 3>(Kernel::Quadratic, m);
+        run::<f32, 3>(Kernel::Cubic, m);
+    }
 }
 
 #[test]
 fn layouts_and_isas_give_the_same_bits_2d_f64() {
-    run::<f64, 2>(Kernel::Quadratic);
-    run::<f64, 2>(Kernel::Cubic);
+    for m in MATERIALS {
+        run::<f64, 2>(Kernel::Quadratic, m);
+        run::<f64, 2>(Kernel::Cubic, m);
+    }
 }
 
 #[test]
 fn layouts_and_isas_give_the_same_bits_3d_f64() {
-    run::<f64, 3>(Kernel::Quadratic);
+    for m in MATERIALS {
+        run::<f64, 3>(Kernel::Quadratic, m);
+    }
 }

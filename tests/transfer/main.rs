@@ -196,6 +196,23 @@ impl<T: Real> Store<T> {
             },
         }
     }
+    /// The bits of every array G2P writes (positions, velocities, `C`, `F_E`, `F_P`,
+    /// temperatures, latent heat, phases).
+    fn bits(&self) -> Vec<u64> {
+        [
+            &self.x,
+            &self.v,
+            &self.affine,
+            &self.f_e,
+            &self.f_p,
+            &self.temperature,
+            &self.latent,
+        ]
+        .iter()
+        .flat_map(|v| v.iter().map(|x| x.to_f64().to_bits()))
+        .chain(self.phase.iter().map(|&c| u64::from(c)))
+        .collect()
+    }
     fn raw(&mut self) -> Particles<T> {
         Particles {
             x: self.x.as_mut_ptr(),

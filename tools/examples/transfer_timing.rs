@@ -1,5 +1,5 @@
 //! Quick split timing of P2G, G2P and the force differential's apply (3D f32 quadratic): `cargo run --release -p ampm-tools
-//! --example transfer_timing -- <fluid|elastic>` (a development aid; the benchmark is
+//! --example transfer_timing -- <fluid|elastic|thermal>` (a development aid; the benchmark is
 //! `tools/benches/particle_levels.rs`).
 use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
@@ -7,7 +7,7 @@ use ampm_core::particle::transfer::force::{self, ForceView};
 use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
 use ampm_core::particle::transfer::{Channel, NodeBox, Particles};
-use ampm_core::particle::{Grid, Kernel, Material, Phase, PhaseParams};
+use ampm_core::particle::{Grid, Heat, Kernel, Material, Phase, PhaseParams};
 
 /// CPU time of this thread (s): unlike wall time, it does not count the time other
 /// processes on a shared machine hold the core.
@@ -36,6 +36,9 @@ fn main() {
     const D: usize = 3;
     let level = std::env::args().nth(1).unwrap_or_else(|| "elastic".into());
     let liquid = level == "fluid";
+    // `thermal`: the elastic level with heat and phase change (solids at 270 K, melting at
+    // 273.15 K).
+    let thermal = level == "thermal";
     let s = 38usize;
     let n = s * s * s;
     let h = 0.02f32;
@@ -74,7 +77,7 @@ fn main() {
     }
     let mass = vec![1e-3f32; n];
     let vol = vec![1e-6f32; n];
-    let mut t = vec![0.0f32; n];
+    let mut t = vec![if thermal { 270.0f32 } else { 0.0 }; n];
     let mut u = vec![0.0f32; n];
     let mut ph = vec![if liquid { Phase::Liquid } else { Phase::Solid } as u8; n];
     let ps = Particles {
@@ -98,13 +101,41 @@ fn main() {
     let mat = Material {
         solid: p,
         liquid: PhaseParams { mu: 0.0, ..p },
+        heat: thermal.then_some(Heat {
+            flip: 0.95,
+            melting_point: 273.15,
+            latent_heat: 3.34e5,
+            phase_change: true,
+        }),
         ..Material::default()
     };
     let dims = [(s / 2 + 8) as i32; D];
     let nn: usize = dims.iter().map(|&d| d as usize).product();
     let stride = [1, dims[0] as isize, (dims[0] * dims[1]) as isize];
-    let mut grid = vec![vec![0.0f32; nn]; 4];
+    // Mass, momentum (3), heat capacity, thermal energy, conductivity, temperatures new, old.
+    let mut grid = vec![vec![0.0f32; nn]; 9];
     let nodes = NodeBox { lo: [0; D], dims };
+    // The heat channels, with heat on only.
+    let heat_ch = |g: &mut Vec<Vec<f32>>, c: usize| {
+        if thermal {
+            Channel {
+                data: g[c].as_mut_ptr(),
+                stride,
+            }
+        } else {
+            Channel::<*mut f32, D>::none()
+        }
+    };
+    let temp_ch = |g: &Vec<Vec<f32>>, c: usize| {
+        if thermal {
+            Channel {
+                data: g[c].as_ptr(),
+                stride,
+            }
+        } else {
+            Channel::<*const f32, D>::none()
+        }
+    };
     let only = std::env::var("AMPM_TT_ISA").ok();
     let mut isas = Isa::available();
     if std::env::var("AMPM_TT_FORCE_AVX2").is_ok() {
@@ -178,15 +209,17 @@ fn main() {
                     stride,
                 }),
                 force: [Channel::<*mut f32, D>::none(); D],
-                heat_capacity: Channel::<*mut f32, D>::none(),
-                thermal_energy: Channel::<*mut f32, D>::none(),
-                conductivity: Channel::<*mut f32, D>::none(),
+                heat_capacity: heat_ch(&mut grid, 4),
+                thermal_energy: heat_ch(&mut grid, 5),
+                conductivity: heat_ch(&mut grid, 6),
             };
             let t0 = Cpu::now();
             // SAFETY: n particles, channels cover the box.
             let st = unsafe { p2g::p2g(isa, &mat, &args, n, &ps, &view) };
             let t1 = t0.elapsed().as_secs_f64();
             assert_eq!(st.error, None);
+            grid[7].iter_mut().for_each(|x| *x = 270.0);
+            grid[8].iter_mut().for_each(|x| *x = 269.9);
             for c in 1..4 {
                 grid[c].iter_mut().for_each(|x| *x = 1e-3);
             }
@@ -196,8 +229,8 @@ fn main() {
                     data: grid[c].as_ptr(),
                     stride,
                 }),
-                temperature: Channel::<*const f32, D>::none(),
-                temperature_old: Channel::<*const f32, D>::none(),
+                temperature: temp_ch(&grid, 7),
+                temperature_old: temp_ch(&grid, 8),
             };
             let gargs = G2pArgs {
                 kernel: Kernel::Quadratic,

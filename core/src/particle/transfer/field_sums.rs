@@ -281,3 +281,107 @@ unsafe fn row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, cons
     }
     v
 }
+
+/// `Σ_i w_i a_i` and `Σ_i w_i (a_i − b_i)` over the `N = K^d` nodes of stencil `s` for two
+/// scalar node channels `a`, `b` (G2P's `Tⁿ⁺¹` and `Tⁿ`) at box-relative base `rel`, by the
+/// contraction of the module docs with `A₀` only: a node row of `a` in lanes `0..K` and of
+/// `a − b` in lanes `4..4 + K` (the node difference is exact when the two are within a factor
+/// 2, Sterbenz). And whether every value read is finite: `a` and `b` are tested, not their
+/// difference, so that a difference that overflows is left to the caller's check of the sums.
+///
+/// # Safety
+/// Every stencil node is inside the box of both channels (checked by `rel_base`).
+#[inline(always)]
+pub(crate) unsafe fn pair_sums<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
+    a: &InChannel<T, D>,
+    b: &InChannel<T, D>,
+) -> (T, T, bool) {
+    debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
+    let z = R::splat(T::ZERO);
+    let sp = R::splat;
+    let w = &s.w;
+    let first = |c: &InChannel<T, D>| {
+        let mut off = 0;
+        for d in 0..D {
+            off += rel[d] * c.stride[d];
+        }
+        c.data.offset(off)
+    };
+    let (pa, pb) = (first(a), first(b));
+    let contiguous = a.stride[0] == 1 && b.stride[0] == 1;
+    let mut chk = z;
+    let mut acc = z;
+    // Axis 2 is `D - 1` in 3D; in 2D there is one level (`o₂ = 0` only, weight 1 not applied).
+    let levels = if D == 3 { K } else { 1 };
+    for o2 in 0..levels {
+        let mut sw = z;
+        for o1 in 0..K {
+            let o = [o1, o2];
+            let (va, vb) = pair_row::<T, R, D, K>(pa, pb, &a.stride, &b.stride, o, contiguous);
+            chk = va.mul_add(z, chk);
+            chk = vb.mul_add(z, chk);
+            sw = (va - vb).mul_add(sp(w[1][o1]), sw);
+        }
+        acc = if D == 3 {
+            sw.mul_add(sp(w[D - 1][o2]), acc)
+        } else {
+            sw
+        };
+    }
+    let mut idx = [T::ZERO; LANES];
+    for (l, x) in idx.iter_mut().enumerate() {
+        *x = T::from_i32((l % SLOT) as i32);
+    }
+    let idx = R::load(&idx);
+    let mut f_w = z;
+    for o0 in 0..K {
+        f_w = R::select(idx.eq(sp(T::from_i32(o0 as i32))), sp(w[0][o0]), f_w);
+    }
+    let mut l = [T::ZERO; LANES];
+    (acc * f_w).store(&mut l);
+    let (mut pic, mut flip) = (l[0], l[SLOT]);
+    for o0 in 1..K {
+        pic += l[o0];
+        flip += l[SLOT + o0];
+    }
+    (pic, flip, R::all(chk.is_finite()))
+}
+
+/// Node row `o` (offsets along axes 1, 2) of two scalar channels for [`pair_sums`]: `a` in
+/// lanes `0..K` and `4..4 + K`, and `b` in lanes `4..4 + K` (others 0), from the stencil's
+/// first node `pa`, `pb` of each.
+///
+/// # Safety
+/// As [`pair_sums`].
+#[inline(always)]
+unsafe fn pair_row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
+    pa: *const T,
+    pb: *const T,
+    sa: &[isize; D],
+    sb: &[isize; D],
+    o: [usize; 2],
+    contiguous: bool,
+) -> (R, R) {
+    let (mut oa, mut ob) = (0isize, 0isize);
+    for d in 1..D {
+        oa += o[d - 1] as isize * sa[d];
+        ob += o[d - 1] as isize * sb[d];
+    }
+    let (ra, rb) = (pa.offset(oa), pb.offset(ob));
+    let low = (1u32 << K) - 1;
+    if contiguous {
+        let va = R::load_mask(ra, low) + R::load_mask(ra.wrapping_sub(SLOT), low << SLOT);
+        let vb = R::load_mask(rb.wrapping_sub(SLOT), low << SLOT);
+        return (va, vb);
+    }
+    let (mut la, mut lb) = ([T::ZERO; LANES], [T::ZERO; LANES]);
+    for o0 in 0..K {
+        let x = ra.offset(o0 as isize * sa[0]).read_unaligned();
+        la[o0] = x;
+        la[SLOT + o0] = x;
+        lb[SLOT + o0] = rb.offset(o0 as isize * sb[0]).read_unaligned();
+    }
+    (R::load(&la), R::load(&lb))
+}

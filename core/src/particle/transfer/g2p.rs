@@ -10,8 +10,8 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::field_sums::{node_field_sums, Sums};
-use super::nodes::{nodes, read, rel_base, table, taint, with_nodes, NodeVals};
+use super::field_sums::{node_field_sums, pair_sums, Sums};
+use super::nodes::{rel_base, taint, with_nodes};
 use super::update_lanes::{self, ChunkSamples};
 use super::{chunk_stencils, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
@@ -299,34 +299,6 @@ where
     Ok(())
 }
 
-/// `Σ w Tⁿ⁺¹` and `Σ w (Tⁿ⁺¹ − Tⁿ)` (the node difference is exact when the two are within a
-/// factor 2, Sterbenz), and whether every value read was finite; `w` the node weights of
-/// stencil `s` ([`nodes`]).
-#[inline(always)]
-unsafe fn temperatures<
-    T: Real,
-    R: Lane<Scalar = T>,
-    const D: usize,
-    const K: usize,
-    const N: usize,
->(
-    s: &Stencil<T, D>,
-    rel: &[isize; D],
-    new: &InChannel<T, D>,
-    old: &InChannel<T, D>,
-) -> (T, T, bool) {
-    let (mut tn, mut to) = (NodeVals::<T, N>::new(), NodeVals::<T, N>::new());
-    let mut chk = read::<T, R, D, K, N>(new.data, &table(new, rel), new.stride[0], &mut tn);
-    chk &= read::<T, R, D, K, N>(old.data, &table(old, rel), old.stride[0], &mut to);
-    let w = nodes::<T, D, K, N>(s).w;
-    let (mut pic, mut flip) = (T::ZERO, T::ZERO);
-    for i in 0..N {
-        pic += w[i] * tn.v[i];
-        flip += w[i] * (tn.v[i] - to.v[i]);
-    }
-    (pic, flip, chk)
-}
-
 /// The grid sample of a particle at `x` with collocated stencil `s`, written to `out` (in
 /// part on error).
 #[inline(always)]
@@ -383,8 +355,9 @@ where
         }
     }
     if material.heat.is_some() {
+        // Σ w Tⁿ⁺¹ and Σ w (Tⁿ⁺¹ − Tⁿ), by separable contraction.
         let (pic, flip, ok) =
-            temperatures::<T, R, D, K, N>(s, &rel, &view.temperature, &view.temperature_old);
+            pair_sums::<T, R, D, K>(s, &rel, &view.temperature, &view.temperature_old);
         finite &= ok;
         out.t_pic = pic;
         out.t_flip = flip;

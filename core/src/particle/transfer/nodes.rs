@@ -193,97 +193,18 @@ pub(crate) fn row_off<const D: usize, const K: usize, const N: usize>(
     s
 }
 
-/// Lanes of the widest row vector [`read`] stores: the eight lanes of the row types of
+/// Lanes of the row vectors: the eight lanes of the row types of
 /// [`crate::kernel::batch::LaneOp::run_rows`].
 const ROW_LANES: usize = 8;
 
-/// One channel's values at the `N = K^d` stencil nodes (node order of [`Nodes`]), with room
-/// for a whole row vector past the last node: [`read`] stores each row of `K` nodes as one
-/// full vector, whose lanes past the row are overwritten by the next row (or land in the
-/// padding), instead of a masked store.
-#[derive(Clone, Copy)]
-#[repr(C)]
-pub(crate) struct NodeVals<T, const N: usize> {
-    /// The node values.
-    pub v: [T; N],
-    pad: [T; ROW_LANES],
-}
-
-impl<T: Real, const N: usize> NodeVals<T, N> {
-    /// Zeros.
-    #[inline(always)]
-    pub(crate) fn new() -> Self {
-        Self {
-            v: [T::ZERO; N],
-            pad: [T::ZERO; ROW_LANES],
-        }
-    }
-
-    /// The values and the padding as one slice (`N + 8` scalars).
-    #[inline(always)]
-    fn all_mut(&mut self) -> &mut [T] {
-        // SAFETY: `repr(C)` with two arrays of `T`: `N + ROW_LANES` contiguous scalars.
-        unsafe { core::slice::from_raw_parts_mut((self as *mut Self).cast::<T>(), N + ROW_LANES) }
-    }
-}
-
-/// Reads an input channel at the `N = K^d` stencil nodes into `out` (node order of
-/// [`Nodes`]); `t` from [`table`], `s0` the channel's axis-0 stride. Returns whether every
-/// value read is finite (tested as read: a separate pass over `out` would reload it with
-/// wider loads than the stores that wrote it, which the store buffer cannot forward). A row
-/// of `K` nodes with `s0 = 1` (separate node arrays) is one contiguous read, kept with one
-/// full-width store: a masked store costs about ten times as much on AMD Zen (microcoded
-/// `vmaskmovps`), and a scalar load of one node from a wider store that contains it is
-/// forwarded.
-///
-/// # Safety
-/// Every stencil node is inside the channel's box (checked by [`rel_base`]).
-#[inline(always)]
-pub(crate) unsafe fn read<
-    T: Real,
-    R: Lane<Scalar = T>,
-    const D: usize,
-    const K: usize,
-    const N: usize,
->(
-    data: *const T,
-    t: &[[isize; 4]; D],
-    s0: isize,
-    out: &mut NodeVals<T, N>,
-) -> bool {
-    let mut ok = true;
-    if s0 == 1 && K <= R::LANES && R::LANES <= ROW_LANES {
-        // A row as one partial vector, stored whole; rows in order, so that each row's
-        // store overwrites the lanes past the previous row.
-        let all = out.all_mut();
-        for r in 0..N / K {
-            let row = R::load_n(data.offset(row_off::<D, K, N>(t, r)), K);
-            ok &= R::all(row.is_finite());
-            row.store(&mut all[r * K..r * K + R::LANES]);
-        }
-        return ok;
-    }
-    for r in 0..N / K {
-        let p = data.offset(row_off::<D, K, N>(t, r));
-        let row: [T; K] = if s0 == 1 {
-            ptr::read_unaligned(p as *const [T; K])
-        } else {
-            core::array::from_fn(|o| ptr::read_unaligned(p.offset(o as isize * s0)))
-        };
-        for o in 0..K {
-            taint(&mut ok, row[o]);
-            out.v[r * K + o] = row[o];
-        }
-    }
-    ok
-}
-
 /// Adds `val` to an output channel at the `N = K^d` stencil nodes, keeping each old value in
 /// `old`. Returns whether every new value is finite (all are written either way; [`restore`]
-/// puts the old ones back). Rows are contiguous with `s0 = 1`, as in [`read`].
+/// puts the old ones back). With `s0 = 1` (separate node arrays) a row of `K` nodes is one
+/// contiguous partial vector.
 ///
 /// # Safety
-/// As [`read`], and the channel is valid for writing.
+/// Every stencil node is inside the channel's box (checked by [`rel_base`]), and the channel
+/// is valid for reading and writing.
 #[inline(always)]
 pub(crate) unsafe fn add<
     T: Real,

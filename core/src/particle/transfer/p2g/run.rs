@@ -94,8 +94,8 @@ where
     }
 
     /// Sets the tile lane vectors of a particle's node values per active channel (see
-    /// [`crate::particle::transfer::tile`]), for lane offset `s0` along axis 0, into `out` (the other entries are
-    /// left as they are).
+    /// [`crate::particle::transfer::tile`]), for lane offset `s0` along axis 0, into `out` (the
+    /// other entries are left as they are).
     #[inline(always)]
     fn set_coef<R: Lane<Scalar = T>, const K: usize>(
         &self,
