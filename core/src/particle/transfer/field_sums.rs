@@ -68,7 +68,6 @@ pub(crate) unsafe fn node_field_sums<
 ) -> Sums<T, D> {
     debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
     let z = R::splat(T::ZERO);
-    let sp = R::splat;
     let (w, dw) = (&s.w, &s.dw);
     let pv = D.div_ceil(2);
     // Separate node arrays of one box (the usual layout) share their strides: one row offset
@@ -83,20 +82,10 @@ pub(crate) unsafe fn node_field_sums<
     } else {
         contract::<T, R, D, K, false, FULL>(ch, rel, s, comps)
     };
-    // Axis 0: the factors in the lanes of their offsets (lane selects, not a vector load of
-    // scalars just stored, which the store buffer could not forward).
-    let mut idx = [T::ZERO; LANES];
-    for (l, x) in idx.iter_mut().enumerate() {
-        *x = T::from_i32((l % SLOT) as i32);
-    }
-    let idx = R::load(&idx);
-    let (mut f_w, mut f_dw, mut f_wo) = (z, z, z);
-    for o0 in 0..K {
-        let m = idx.eq(sp(T::from_i32(o0 as i32)));
-        f_w = R::select(m, sp(w[0][o0]), f_w);
-        f_dw = R::select(m, sp(dw[0][o0]), f_dw);
-        f_wo = R::select(m, sp(w[0][o0] * T::from_i32(o0 as i32)), f_wo);
-    }
+    // Axis 0: the factors in the lanes of their offsets.
+    let f_w = in_slots::<T, R, K>(|o0| w[0][o0]);
+    let f_dw = in_slots::<T, R, K>(|o0| dw[0][o0]);
+    let f_wo = in_slots::<T, R, K>(|o0| w[0][o0] * T::from_i32(o0 as i32));
     let mut out = Sums {
         v: [T::ZERO; D],
         mo: Mat::ZERO,
@@ -180,11 +169,7 @@ unsafe fn contract<
     let mut p = [core::ptr::null::<T>(); D];
     for (a, pa) in p.iter_mut().enumerate() {
         if comps.0 <= a && a < comps.1 {
-            let mut off = 0;
-            for b in 0..D {
-                off += rel[b] * ch[a].stride[b];
-            }
-            *pa = ch[a].data.offset(off);
+            *pa = first_node(&ch[a], rel);
         }
     }
     // Σ x·0 over every vector read: NaN exactly when some value read is not finite (one
@@ -302,14 +287,7 @@ pub(crate) unsafe fn pair_sums<T: Real, R: Lane<Scalar = T>, const D: usize, con
     let z = R::splat(T::ZERO);
     let sp = R::splat;
     let w = &s.w;
-    let first = |c: &InChannel<T, D>| {
-        let mut off = 0;
-        for d in 0..D {
-            off += rel[d] * c.stride[d];
-        }
-        c.data.offset(off)
-    };
-    let (pa, pb) = (first(a), first(b));
+    let (pa, pb) = (first_node(a, rel), first_node(b, rel));
     let contiguous = a.stride[0] == 1 && b.stride[0] == 1;
     let mut chk = z;
     let mut acc = z;
@@ -330,15 +308,7 @@ pub(crate) unsafe fn pair_sums<T: Real, R: Lane<Scalar = T>, const D: usize, con
             sw
         };
     }
-    let mut idx = [T::ZERO; LANES];
-    for (l, x) in idx.iter_mut().enumerate() {
-        *x = T::from_i32((l % SLOT) as i32);
-    }
-    let idx = R::load(&idx);
-    let mut f_w = z;
-    for o0 in 0..K {
-        f_w = R::select(idx.eq(sp(T::from_i32(o0 as i32))), sp(w[0][o0]), f_w);
-    }
+    let f_w = in_slots::<T, R, K>(|o0| w[0][o0]);
     let mut l = [T::ZERO; LANES];
     (acc * f_w).store(&mut l);
     let (mut pic, mut flip) = (l[0], l[SLOT]);
@@ -384,4 +354,34 @@ unsafe fn pair_row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>
         lb[SLOT + o0] = rb.offset(o0 as isize * sb[0]).read_unaligned();
     }
     (R::load(&la), R::load(&lb))
+}
+
+/// The address of a stencil's first node (box-relative base `rel`) in channel `c`.
+///
+/// # Safety
+/// The node is inside the channel's box.
+#[inline(always)]
+unsafe fn first_node<T, const D: usize>(c: &InChannel<T, D>, rel: &[isize; D]) -> *const T {
+    let mut off = 0;
+    for d in 0..D {
+        off += rel[d] * c.stride[d];
+    }
+    c.data.offset(off)
+}
+
+/// `f(o₀)` in lanes `o₀` and `4 + o₀` of a row vector (`o₀ < K`; the other lanes 0), put
+/// together by lane selects: a vector load of scalars just stored would wait for the stores
+/// to reach the cache (no store forwarding). `f` computes scalars only.
+#[inline(always)]
+fn in_slots<T: Real, R: Lane<Scalar = T>, const K: usize>(f: impl Fn(usize) -> T) -> R {
+    let mut idx = [T::ZERO; LANES];
+    for (l, x) in idx.iter_mut().enumerate() {
+        *x = T::from_i32((l % SLOT) as i32);
+    }
+    let idx = R::load(&idx);
+    let mut v = R::splat(T::ZERO);
+    for o0 in 0..K {
+        v = R::select(idx.eq(R::splat(T::from_i32(o0 as i32))), R::splat(f(o0)), v);
+    }
+    v
 }
