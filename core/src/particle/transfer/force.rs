@@ -10,7 +10,7 @@
 
 use super::field_sums::node_field_sums;
 use super::nodes::{add, nodes, rel_base, restore, table, with_nodes};
-use super::tile::{axis0, factors, set_grad, Coef, Tile, MAX_RUN, TILE_X};
+use super::tile::{axis0, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use super::OutChannel;
 use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
@@ -409,7 +409,7 @@ where
         for (a, c) in coef.iter_mut().enumerate() {
             set_grad(c, w, dw, m, a, T::ONE);
         }
-        tile.add::<K, N>(&sp, &factors::<T, D, K, N>(s), &coef);
+        tile.add::<K>(&sp, s, &coef);
         run[*nrun] = i;
         *nrun += 1;
     }

@@ -18,15 +18,21 @@
 //! `l = 0..8`, in lanes `l`. A particle's stencil row (axis-0 nodes `b₀ + o₀`, other offsets
 //! `o_a`) adds into tile row `t_a = b_a − org_a + o_a` at lanes `s₀ + o₀`, `s₀ = b₀ − org₀`.
 //!
-//! **Node values** in a stencil row, with `c` the row factors of [`super::nodes`] (`c₀` the
-//! product of the other axes' weights, `c_a` the same with `∂w_a` for `w_a`) and `W`, `W'` the
-//! axis-0 weights and derivatives in their tile lanes: every channel's value is
-//! `c₀ P + Σ_{a≥1} c₀ o_a E_a + Σ_{a≥1} c_a B_a` with per-particle lane vectors `P`, `E_a`,
-//! `B_a` ([`Coef`]); e.g. component `k` of the momentum, `w (q₀ + m C h o)_k + Δt_f f_k` with
-//! `f = fm ∇w` (`fm = −V⁰ τ`), gives `P = W (q₀ₖ + (mCh)_{k0} o₀) + Δt_f W' fm_{k0}`,
-//! `E_a = W (mCh)_{ka}`, `B_a = Δt_f W fm_{ka}`, where `o₀` is the lane's axis-0 offset from the
-//! particle's base node. The values are those of the per-node formulas up to rounding (products
-//! and sums in another order).
+//! **Node values.** With `w_a[o]`, `dw_a[o]` the stencil's per-axis weights and derivatives
+//! (1/m) and `W`, `W'` the axis-0 ones in their tile lanes, node `o` has weight `w = W c₀` and
+//! gradient `(W' c₀, W c₁, W c₂)`, where `c₀ = w₁[o₁] w₂[o₂]` and `c_a` is `c₀` with `dw_a` for
+//! `w_a` (a B-spline weight is a product of per-axis factors). Every channel's value in
+//! stencil row `(o₁, o₂)` is `c₀ P + Σ_{a≥1} c₀ o_a E_a + Σ_{a≥1} c_a B_a` with per-particle
+//! lane vectors `P`, `E_a`, `B_a` ([`Coef`]); e.g. component `k` of the momentum,
+//! `w (q₀ + m C h o)_k + Δt_f f_k` with `f = fm ∇w` (`fm = −V⁰ τ`), gives
+//! `P = W (q₀ₖ + (mCh)_{k0} o₀) + Δt_f W' fm_{k0}`, `E_a = W (mCh)_{ka}`,
+//! `B_a = Δt_f W fm_{ka}`, where `o₀` is the lane's axis-0 offset from the particle's base
+//! node. It is summed factored, axis 2 first: per `o₂`,
+//! `U = w₂[o₂] (P + o₂ E₂) + dw₂[o₂] B₂`, `V = w₂[o₂] E₁` and `W_B = w₂[o₂] B₁` (in 2D `U = P`,
+//! `V = E₁`, `W_B = B₁`), and per `o₁` the row adds `w₁[o₁] (U + o₁ V) + dw₁[o₁] W_B`: two
+//! multiply-adds per row and channel instead of one per term, and no per-row factor is formed.
+//! The values are those of the per-node formulas up to rounding (products and sums in
+//! another order).
 //!
 //! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
 //! the old values are put back and the run's particles are added one by one by the
@@ -34,7 +40,7 @@
 //! adding its particles one by one would pass through a non-finite value (the sum of two
 //! huge opposite contributions): the run is then accepted, with the finite, more accurate sum.
 
-use super::nodes::{lane_index, row_factors, Offsets};
+use super::nodes::lane_index;
 use super::OutChannel;
 use crate::lane::Lane;
 use crate::mat::Mat;
@@ -53,8 +59,6 @@ pub(super) const MAX_RUN: usize = 48;
 pub(super) const MAX_CH: usize = 10;
 /// Largest dimension.
 const MAX_D: usize = 3;
-/// Most stencil rows `K^{d−1}` (the cubic kernel in 3D).
-const MAX_STENCIL_ROWS: usize = 16;
 
 /// The per-particle lane vectors of one channel's node values (see the module docs). A term
 /// that the channel does not have is skipped (`has_e`, `has_b` false). Plain arrays and flags
@@ -132,78 +136,92 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         Some(s)
     }
 
-    /// Adds the node values of one particle: stencil rows `r` (`N/K` of them, axis-0 nodes
-    /// `r·K..r·K + K`) with row factors `c[r]`, for channels `0..coef.len()` with the lane
-    /// vectors `coef`.
+    /// Adds the node values of one particle with stencil `st` (`K` nodes per axis) at lane
+    /// offsets `s`, for channels `0..coef.len()` with the lane vectors `coef`, in the factored
+    /// form of the module docs.
     #[inline(always)]
-    pub fn add<const K: usize, const N: usize>(
-        &mut self,
-        s: &[usize; D],
-        c: &[[T; D]; N],
-        coef: &[Coef<R, D>],
-    ) {
+    pub fn add<const K: usize>(&mut self, s: &[usize; D], st: &Stencil<T, D>, coef: &[Coef<R, D>]) {
+        debug_assert!((2..=MAX_D).contains(&D));
         let lanes = ((1u32 << K) - 1) << s[0];
-        // Per stencil row: its tile row `t` and the factors `c₀`, `c₀ o_a`, `c_a` (a ≥ 1).
-        debug_assert!(N / K <= MAX_STENCIL_ROWS);
-        let mut rt = [0usize; MAX_STENCIL_ROWS];
-        let mut fc = [[T::ZERO; 2 * MAX_D]; MAX_STENCIL_ROWS];
-        for (r, cr) in c.iter().enumerate().take(N / K) {
-            // Node r·K has o₀ = 0: the row's offsets along axes 1...
-            let o = Offsets::<D, K, N>::O[r * K];
-            let mut t = 0usize;
-            let mut step = 1usize;
-            fc[r][0] = cr[0];
-            for a in 1..D {
-                t += (s[a] + o[a]) * step;
-                step *= K + 1;
-                fc[r][a] = cr[0] * T::from_i32(o[a] as i32);
-                fc[r][D + a] = cr[a];
+        // The tile row of stencil row (o₁, o₂): `rt[o₂][o₁]` (o₂ = 0 only in 2D).
+        let mut rt = [[0usize; 4]; 4];
+        for (o2, row) in rt.iter_mut().enumerate().take(outer::<D, K>()) {
+            for (o1, t) in row.iter_mut().enumerate().take(K) {
+                *t = s[1] + o1;
+                if D == 3 {
+                    *t += (s[2] + o2) * (K + 1);
+                }
+                self.bits[*t] |= lanes;
             }
-            self.bits[t] |= lanes;
-            rt[r] = t;
         }
-        // Channel by channel, so that its lane vectors and terms are chosen once.
+        // Channel by channel, with the terms it has chosen once.
         for (j, k) in coef.iter().enumerate() {
             let acc = &mut self.acc[j];
             match (k.has_e, k.has_b) {
-                (false, false) => {
-                    for r in 0..N / K {
-                        acc[rt[r]] = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
-                    }
-                }
-                (true, false) => {
-                    for r in 0..N / K {
-                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
-                        for a in 1..D {
-                            v = R::splat(fc[r][a]).mul_add(k.e[a], v);
-                        }
-                        acc[rt[r]] = v;
-                    }
-                }
-                (false, true) => {
-                    for r in 0..N / K {
-                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
-                        for a in 1..D {
-                            v = R::splat(fc[r][D + a]).mul_add(k.b[a], v);
-                        }
-                        acc[rt[r]] = v;
-                    }
-                }
-                (true, true) => {
-                    for r in 0..N / K {
-                        let mut v = R::splat(fc[r][0]).mul_add(k.p, acc[rt[r]]);
-                        for a in 1..D {
-                            v = R::splat(fc[r][a]).mul_add(k.e[a], v);
-                        }
-                        for a in 1..D {
-                            v = R::splat(fc[r][D + a]).mul_add(k.b[a], v);
-                        }
-                        acc[rt[r]] = v;
-                    }
-                }
+                (false, false) => add_channel::<T, R, D, K, false, false>(acc, &rt, st, k),
+                (true, false) => add_channel::<T, R, D, K, true, false>(acc, &rt, st, k),
+                (false, true) => add_channel::<T, R, D, K, false, true>(acc, &rt, st, k),
+                (true, true) => add_channel::<T, R, D, K, true, true>(acc, &rt, st, k),
             }
         }
         self.used = true;
+    }
+}
+
+/// The stencil rows along axis 2 (`K` in 3D, one in 2D).
+#[inline(always)]
+const fn outer<const D: usize, const K: usize>() -> usize {
+    if D == 3 {
+        K
+    } else {
+        1
+    }
+}
+
+/// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B`)
+/// into the tile rows `rt` (see [`Tile::add`]): per axis-2 offset `o₂` the vectors `U`, `V`,
+/// `W_B` of the module docs, then per axis-1 offset `o₁` two multiply-adds.
+#[inline(always)]
+fn add_channel<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const E: bool,
+    const B: bool,
+>(
+    acc: &mut [R; MAX_ROWS],
+    rt: &[[usize; 4]; 4],
+    st: &Stencil<T, D>,
+    k: &Coef<R, D>,
+) {
+    let sp = R::splat;
+    for (o2, row) in rt.iter().enumerate().take(outer::<D, K>()) {
+        let (mut u, mut v, mut wb) = (k.p, k.e[1], k.b[1]);
+        if D == 3 {
+            let w2 = sp(st.w[2][o2]);
+            if E {
+                u = sp(T::from_i32(o2 as i32)).mul_add(k.e[2], u);
+                v = w2 * v;
+            }
+            u = w2 * u;
+            if B {
+                u = sp(st.dw[2][o2]).mul_add(k.b[2], u);
+                wb = w2 * wb;
+            }
+        }
+        for (o1, &t) in row.iter().enumerate().take(K) {
+            let y = if E && o1 > 0 {
+                sp(T::from_i32(o1 as i32)).mul_add(v, u)
+            } else {
+                u
+            };
+            let mut a = sp(st.w[1][o1]).mul_add(y, acc[t]);
+            if B {
+                a = sp(st.dw[1][o1]).mul_add(wb, a);
+            }
+            acc[t] = a;
+        }
     }
 }
 
@@ -347,16 +365,4 @@ pub(super) fn set_grad<T: Real, R: Lane<Scalar = T>, const D: usize>(
     }
     c.has_e = false;
     c.has_b = true;
-}
-
-/// The row factors ([`row_factors`]) of every stencil row (`N/K` rows; entries past them 0).
-#[inline(always)]
-pub(super) fn factors<T: Real, const D: usize, const K: usize, const N: usize>(
-    s: &Stencil<T, D>,
-) -> [[T; D]; N] {
-    let mut c = [[T::ZERO; D]; N];
-    for (q, cq) in c.iter_mut().enumerate().take(N / K) {
-        *cq = row_factors::<T, D, K, N>(s, q);
-    }
-    c
 }

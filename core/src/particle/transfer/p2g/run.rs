@@ -14,9 +14,7 @@ use crate::particle::stencil::Stencil;
 use crate::particle::transfer::nodes::{
     add, node_offsets, nodes, rel_base, restore, table, with_nodes,
 };
-use crate::particle::transfer::tile::{
-    axis0, factors, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X,
-};
+use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use crate::particle::transfer::BatchStatus;
 use core::mem::MaybeUninit;
 
@@ -158,7 +156,7 @@ where
             self.flush::<R, K, N>(tile, run, oc);
         };
         self.set_coef::<R, K>(r, s[0], coef);
-        tile.add::<K, N>(&s, &factors::<T, D, K, N>(r.s), &coef[..self.na]);
+        tile.add::<K>(&s, r.s, &coef[..self.na]);
         run.idx[run.n] = i;
         run.tau[run.n] = tau_dev;
         run.n += 1;
