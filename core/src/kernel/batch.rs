@@ -109,6 +109,7 @@ pub(crate) trait LaneOp<T> {
     /// moves. On for P2G and the force differential (AMD Zen 4: the apply about 15 % faster);
     /// off for the kernels, whose 2D f64 batch measured slower with it. G2P runs its AVX2
     /// build under AVX-512 (see `g2p_update`).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const AVX512_VL: bool = false;
 }
 
