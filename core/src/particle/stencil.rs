@@ -33,6 +33,9 @@ use crate::lane::Lane;
 use crate::scalar::Real;
 use core::ptr::write_volatile;
 
+/// Most nodes per axis of a stencil (the cubic kernel).
+pub(crate) const MAX_WIDTH: usize = 4;
+
 /// The B-spline interpolation kernel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Kernel {
@@ -168,9 +171,9 @@ pub struct Stencil<T, const D: usize> {
     /// Particle position relative to the base node, in cells (`[½, ³⁄₂)` or `[1, 2)`).
     pub fx: [T; D],
     /// Per-axis weights `N(fx_a − o)`, `o < K` (unused entries 0).
-    pub w: [[T; 4]; D],
+    pub w: [[T; MAX_WIDTH]; D],
     /// Per-axis derivatives `N'(fx_a − o)/h` (1/m).
-    pub dw: [[T; 4]; D],
+    pub dw: [[T; MAX_WIDTH]; D],
 }
 
 /// The position limit: positions with `|x/h| ≥ 2³⁰` (cell indices that do not fit
@@ -205,8 +208,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             h,
             base: [0; D],
             fx: [T::ZERO; D],
-            w: [[T::ZERO; 4]; D],
-            dw: [[T::ZERO; 4]; D],
+            w: [[T::ZERO; MAX_WIDTH]; D],
+            dw: [[T::ZERO; MAX_WIDTH]; D],
         }
     }
 
@@ -256,8 +259,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         // and then copied lane by lane into the stencils.
         let mut fl_buf = [T::ZERO; MAX];
         let mut fx_buf = [T::ZERO; MAX];
-        let mut w_buf = [[T::ZERO; MAX]; 4];
-        let mut dw_buf = [[T::ZERO; MAX]; 4];
+        let mut w_buf = [[T::ZERO; MAX]; MAX_WIDTH];
+        let mut dw_buf = [[T::ZERO; MAX]; MAX_WIDTH];
         let k = kernel.width();
         for a in 0..D {
             for (b, x) in fx_buf.iter_mut().zip(xs).take(n) {
@@ -302,7 +305,7 @@ impl<T: Real, const D: usize> Stencil<T, D> {
                 unsafe {
                     write_volatile(&mut st.base[a], base);
                     write_volatile(&mut st.fx[a], fx_buf[l]);
-                    for o in 0..4 {
+                    for o in 0..MAX_WIDTH {
                         // Unused entries are 0, as in `Stencil::new`.
                         let used = o < k;
                         write_volatile(&mut st.w[a][o], if used { w_buf[o][l] } else { T::ZERO });

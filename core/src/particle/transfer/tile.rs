@@ -44,7 +44,7 @@ use super::nodes::lane_index;
 use super::OutChannel;
 use crate::lane::Lane;
 use crate::mat::Mat;
-use crate::particle::stencil::Stencil;
+use crate::particle::stencil::{Stencil, MAX_WIDTH};
 use crate::scalar::Real;
 use core::mem::MaybeUninit;
 
@@ -144,7 +144,7 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         debug_assert!((2..=MAX_D).contains(&D));
         let lanes = ((1u32 << K) - 1) << s[0];
         // The tile row of stencil row (o₁, o₂): `rt[o₂][o₁]` (o₂ = 0 only in 2D).
-        let mut rt = [[0usize; 4]; 4];
+        let mut rt = [[0usize; MAX_WIDTH]; MAX_WIDTH];
         for (o2, row) in rt.iter_mut().enumerate().take(outer::<D, K>()) {
             for (o1, t) in row.iter_mut().enumerate().take(K) {
                 *t = s[1] + o1;
@@ -191,7 +191,7 @@ fn add_channel<
     const B: bool,
 >(
     acc: &mut [R; MAX_ROWS],
-    rt: &[[usize; 4]; 4],
+    rt: &[[usize; MAX_WIDTH]; MAX_WIDTH],
     st: &Stencil<T, D>,
     k: &Coef<R, D>,
 ) {
