@@ -79,6 +79,31 @@ pub trait Lane:
     /// # Safety
     /// Every such `base.add(i·stride)` is valid for writing; `i·stride < 2³¹`.
     unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32);
+    /// Structure-of-arrays view of `LANES` consecutive records of `rec` scalars: `out[c]`
+    /// lane `i` is `*base.add(i·rec + c)` for `c < out.len() ≤ rec` (a particle array of
+    /// `d × d` matrices, say). Gathers by default; the eight-lane `f32` type loads the records
+    /// and transposes them in registers (same values, fewer and cheaper instructions).
+    ///
+    /// # Safety
+    /// Every `base.add(i·rec + c)`, `i < LANES`, `c < out.len()`, is valid for reading;
+    /// `LANES·rec < 2³¹`.
+    #[inline(always)]
+    unsafe fn load_records(base: *const Self::Scalar, rec: usize, out: &mut [Self]) {
+        for (c, o) in out.iter_mut().enumerate() {
+            *o = Self::gather(base.add(c), rec);
+        }
+    }
+    /// The inverse of [`Lane::load_records`]: writes `vals[c]` lane `i` to
+    /// `*base.add(i·rec + c)` for `c < vals.len() ≤ rec`, every lane.
+    ///
+    /// # Safety
+    /// Every such address is valid for writing; `LANES·rec < 2³¹`.
+    #[inline(always)]
+    unsafe fn store_records(base: *mut Self::Scalar, rec: usize, vals: &[Self]) {
+        for (c, v) in vals.iter().enumerate() {
+            v.scatter(base.add(c), rec, u32::MAX);
+        }
+    }
     /// Lanes `0..n` from `p[0..n]`, the others 0 (`n ≤ LANES`).
     ///
     /// # Safety

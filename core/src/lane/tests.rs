@@ -1,4 +1,5 @@
-//! Tests of the lane types: partial and masked loads and stores on every lane type the CPU has.
+//! Tests of the lane types: partial, masked and record (transposing) loads and stores on every
+//! lane type the CPU has.
 
 use super::{Lane, X2};
 
@@ -62,25 +63,72 @@ fn partial<V: Lane>() {
     }
 }
 
+/// `load_records` / `store_records` agree with the definition (lane `i`, component `c` at
+/// `i·rec + c`) for every record length up to 26 and every component count, and
+/// `store_records` writes nothing else.
+fn records<V: Lane>() {
+    let sentinel = V::Scalar::from_i32(-7);
+    for rec in 1..=26usize {
+        let len = V::LANES * rec;
+        let src: std::vec::Vec<V::Scalar> = (0..len)
+            .map(|i| V::Scalar::from_i32(i as i32 + 1))
+            .collect();
+        for n in 1..=rec {
+            let mut out = [V::splat(V::Scalar::ZERO); 26];
+            // SAFETY: `src` holds LANES records of `rec ≥ n` scalars.
+            unsafe { V::load_records(src.as_ptr(), rec, &mut out[..n]) };
+            let mut dst = std::vec![sentinel; len];
+            // SAFETY: as above, for writing.
+            unsafe { V::store_records(dst.as_mut_ptr(), rec, &out[..n]) };
+            for (c, v) in out[..n].iter().enumerate() {
+                let mut lanes = [V::Scalar::ZERO; 32];
+                v.store(&mut lanes);
+                for (i, x) in lanes[..V::LANES].iter().enumerate() {
+                    let want = src[i * rec + c].to_f64();
+                    assert_eq!(
+                        x.to_f64(),
+                        want,
+                        "load_records rec {rec} n {n} c {c} lane {i}"
+                    );
+                }
+            }
+            for (k, x) in dst.iter().enumerate() {
+                let want = if k % rec < n { src[k] } else { sentinel };
+                assert_eq!(
+                    x.to_f64(),
+                    want.to_f64(),
+                    "store_records rec {rec} n {n} at {k}"
+                );
+            }
+        }
+    }
+}
+
+/// Every test above on lane type `V`.
+fn all<V: Lane>() {
+    partial::<V>();
+    records::<V>();
+}
+
 use crate::scalar::Real;
 
 #[test]
-fn partial_loads_and_stores() {
-    partial::<f32>();
-    partial::<X2<X2<X2<f64>>>>();
+fn partial_and_record_loads_and_stores() {
+    all::<f32>();
+    all::<X2<X2<X2<f64>>>>();
     #[cfg(target_arch = "x86_64")]
     {
         #[target_feature(enable = "avx2,fma")]
         unsafe fn avx2() {
-            partial::<super::F32x8>();
-            partial::<super::F64x4>();
-            partial::<X2<super::F32x8>>();
+            all::<super::F32x8>();
+            all::<super::F64x4>();
+            all::<X2<super::F32x8>>();
         }
         #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
         unsafe fn avx512() {
-            partial::<super::F32x16>();
-            partial::<super::F64x8>();
-            partial::<X2<super::F64x8>>();
+            all::<super::F32x16>();
+            all::<super::F64x8>();
+            all::<X2<super::F64x8>>();
         }
         if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU has AVX2 and FMA.

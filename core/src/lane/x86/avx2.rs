@@ -29,6 +29,38 @@ vmask!(
     _mm256_castsi256_ps(_mm256_set1_epi32(-1))
 );
 
+/// The transpose of the 8 × 8 matrix whose rows are `r` (the usual unpack, shuffle,
+/// 128-bit permute sequence: 24 shuffles).
+#[inline(always)]
+unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
+    let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+    let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+    let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    let t4 = _mm256_unpacklo_ps(r[4], r[5]);
+    let t5 = _mm256_unpackhi_ps(r[4], r[5]);
+    let t6 = _mm256_unpacklo_ps(r[6], r[7]);
+    let t7 = _mm256_unpackhi_ps(r[6], r[7]);
+    let s0 = _mm256_shuffle_ps::<0x44>(t0, t2);
+    let s1 = _mm256_shuffle_ps::<0xEE>(t0, t2);
+    let s2 = _mm256_shuffle_ps::<0x44>(t1, t3);
+    let s3 = _mm256_shuffle_ps::<0xEE>(t1, t3);
+    let s4 = _mm256_shuffle_ps::<0x44>(t4, t6);
+    let s5 = _mm256_shuffle_ps::<0xEE>(t4, t6);
+    let s6 = _mm256_shuffle_ps::<0x44>(t5, t7);
+    let s7 = _mm256_shuffle_ps::<0xEE>(t5, t7);
+    [
+        _mm256_permute2f128_ps::<0x20>(s0, s4),
+        _mm256_permute2f128_ps::<0x20>(s1, s5),
+        _mm256_permute2f128_ps::<0x20>(s2, s6),
+        _mm256_permute2f128_ps::<0x20>(s3, s7),
+        _mm256_permute2f128_ps::<0x31>(s0, s4),
+        _mm256_permute2f128_ps::<0x31>(s1, s5),
+        _mm256_permute2f128_ps::<0x31>(s2, s6),
+        _mm256_permute2f128_ps::<0x31>(s3, s7),
+    ]
+}
+
 /// The AVX2 mask of lanes `0..n` of eight 32-bit lanes (sign bits set).
 #[inline(always)]
 unsafe fn mask8(n: usize) -> __m256i {
@@ -88,6 +120,59 @@ impl Lane for F32x8 {
             _mm256_set1_epi32(s),
         );
         F32x8(_mm256_i32gather_ps::<4>(base, idx))
+    }
+    #[inline(always)]
+    unsafe fn load_records(base: *const f32, rec: usize, out: &mut [Self]) {
+        debug_assert!(out.len() <= rec);
+        // Blocks of up to eight components: one (masked) load per record, an 8 × 8
+        // transpose; a last one or two components are gathered.
+        let mut c0 = 0;
+        while out.len() - c0 >= 3 {
+            let m = (out.len() - c0).min(8);
+            let mut r = [_mm256_setzero_ps(); 8];
+            for (l, x) in r.iter_mut().enumerate() {
+                let p = base.add(rec * l + c0);
+                *x = if m == 8 {
+                    _mm256_loadu_ps(p)
+                } else {
+                    _mm256_maskload_ps(p, mask8(m))
+                };
+            }
+            let t = transpose8(r);
+            for (o, x) in out[c0..c0 + m].iter_mut().zip(t) {
+                *o = F32x8(x);
+            }
+            c0 += m;
+        }
+        for (c, o) in out.iter_mut().enumerate().skip(c0) {
+            *o = Self::gather(base.add(c), rec);
+        }
+    }
+    #[inline(always)]
+    unsafe fn store_records(base: *mut f32, rec: usize, vals: &[Self]) {
+        debug_assert!(vals.len() <= rec);
+        let mut c0 = 0;
+        while vals.len() - c0 >= 3 {
+            let m = (vals.len() - c0).min(8);
+            let mut r = [_mm256_setzero_ps(); 8];
+            for (x, v) in r.iter_mut().zip(&vals[c0..c0 + m]) {
+                *x = v.0;
+            }
+            // The transpose is its own inverse: row `l` is record `l`'s block.
+            let t = transpose8(r);
+            for (l, x) in t.iter().enumerate() {
+                let p = base.add(rec * l + c0);
+                if m == 8 {
+                    _mm256_storeu_ps(p, *x);
+                } else {
+                    _mm256_maskstore_ps(p, mask8(m), *x);
+                }
+            }
+            c0 += m;
+        }
+        for (c, v) in vals.iter().enumerate().skip(c0) {
+            v.scatter(base.add(c), rec, u32::MAX);
+        }
     }
     #[inline(always)]
     unsafe fn load_n(p: *const f32, n: usize) -> Self {

@@ -509,24 +509,25 @@ unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
     let z = R::splat(T::ZERO);
     // Slot entries 1.. (after the tag): at most those of a 3D slot.
     let mut e = [z; slot_len(3) - 1];
-    for (k, x) in e.iter_mut().enumerate().take(sl - 1) {
-        *x = R::gather(slots.add(1 + k), sl);
-    }
+    R::load_records(slots.add(1), sl, &mut e[..sl - 1]);
     // `Mat` is `repr(C)` around `[[T; D]; D]`: entry (i, j) of particle `l` is scalar
     // `l·d² + j·d + i` of the arrays.
     let (gp, mp) = (gs.as_ptr().cast::<T>(), ms.as_mut_ptr().cast::<T>());
+    let mut flat = [z; 9];
+    R::load_records(gp, D * D, &mut flat[..D * D]);
     let mut g = [[z; D]; D];
     for (j, col) in g.iter_mut().enumerate() {
         for (i, x) in col.iter_mut().enumerate() {
-            *x = R::gather(gp.add(j * D + i), D * D);
+            *x = flat[j * D + i];
         }
     }
     let m = apply_entries::<R, D>(&e[..sl - 1], &g);
     for (j, col) in m.iter().enumerate() {
         for (i, x) in col.iter().enumerate() {
-            x.scatter(mp.add(j * D + i), D * D, u32::MAX);
+            flat[j * D + i] = *x;
         }
     }
+    R::store_records(mp, D * D, &flat[..D * D]);
 }
 
 /// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`), by the

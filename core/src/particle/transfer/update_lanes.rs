@@ -85,10 +85,13 @@ unsafe fn gather_mat<T: Real, V: Lane<Scalar = T>, const D: usize>(
     p: *const T,
     start: usize,
 ) -> LMat<V, D> {
+    let z = V::splat(T::ZERO);
+    let mut e = [z; 9];
+    V::load_records(p.add(D * D * start), D * D, &mut e[..D * D]);
     let mut m = lmat::zero::<V, D>();
     for j in 0..D {
         for i in 0..D {
-            m[j][i] = V::gather(p.add(D * D * start + i + D * j), D * D);
+            m[j][i] = e[i + D * j];
         }
     }
     m
@@ -394,9 +397,7 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     }
     let zero = V::splat(T::ZERO);
     let mut x = [zero; D];
-    for (a, xa) in x.iter_mut().enumerate() {
-        *xa = V::gather(ps.x.add(D * start + a), D);
-    }
+    V::load_records(ps.x.add(D * start), D, &mut x);
     let f_e = gather_mat::<T, V, D>(ps.f_e, start);
     let f_p = gather_mat::<T, V, D>(ps.f_p, start);
     let mass = V::load(core::slice::from_raw_parts(ps.mass.add(start), LANES));
