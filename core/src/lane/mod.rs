@@ -94,14 +94,31 @@ pub trait Lane:
         }
     }
     /// The inverse of [`Lane::load_records`]: writes `vals[c]` lane `i` to
-    /// `*base.add(i·rec + c)` for `c < vals.len() ≤ rec`, every lane.
+    /// `*base.add(i·rec + c)` for `c < vals.len() ≤ rec`, every lane. By default one scalar
+    /// store per value (volatile, so that the compiler does not turn them into scatter
+    /// instructions, which are slow on AMD Zen 4); the `f32` vector types transpose in
+    /// registers and store whole records.
     ///
     /// # Safety
-    /// Every such address is valid for writing; `LANES·rec < 2³¹`.
+    /// Every such address is valid for writing; `LANES·rec < 2³¹`; `LANES ≤ 32`.
     #[inline(always)]
     unsafe fn store_records(base: *mut Self::Scalar, rec: usize, vals: &[Self]) {
+        let mut b = [Self::Scalar::ZERO; 32];
         for (c, v) in vals.iter().enumerate() {
-            v.scatter(base.add(c), rec, u32::MAX);
+            v.store(&mut b);
+            for (i, x) in b.iter().enumerate().take(Self::LANES) {
+                core::ptr::write_volatile(base.add(i * rec + c), *x);
+            }
+        }
+    }
+    /// Lane `i` truncated toward zero into `out[i]` (`out.len() ≥ LANES ≤ 32`); exact for an
+    /// integer in the range of `i32`, unspecified (but no fault) for any other lane value.
+    #[inline(always)]
+    fn to_i32s(self, out: &mut [i32]) {
+        let mut b = [Self::Scalar::ZERO; 32];
+        self.store(&mut b);
+        for (o, x) in out.iter_mut().zip(&b[..Self::LANES]) {
+            *o = x.to_f64() as i32;
         }
     }
     /// Lanes `0..n` from `p[0..n]`, the others 0 (`n ≤ LANES`).
@@ -536,6 +553,37 @@ impl<V: Lane> Lane for X2<V> {
     unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32) {
         self.0[0].scatter(base, stride, keep);
         self.0[1].scatter(base.add(V::LANES * stride), stride, keep >> V::LANES);
+    }
+    #[inline(always)]
+    unsafe fn load_records(base: *const Self::Scalar, rec: usize, out: &mut [Self]) {
+        let n = out.len();
+        let (mut lo, mut hi) = (
+            [V::splat(Self::Scalar::ZERO); 32],
+            [V::splat(Self::Scalar::ZERO); 32],
+        );
+        V::load_records(base, rec, &mut lo[..n]);
+        V::load_records(base.add(V::LANES * rec), rec, &mut hi[..n]);
+        for (o, (l, h)) in out.iter_mut().zip(lo.iter().zip(&hi)) {
+            *o = X2([*l, *h]);
+        }
+    }
+    #[inline(always)]
+    unsafe fn store_records(base: *mut Self::Scalar, rec: usize, vals: &[Self]) {
+        let n = vals.len();
+        let (mut lo, mut hi) = (
+            [V::splat(Self::Scalar::ZERO); 32],
+            [V::splat(Self::Scalar::ZERO); 32],
+        );
+        for (v, (l, h)) in vals.iter().zip(lo.iter_mut().zip(hi.iter_mut())) {
+            [*l, *h] = v.0;
+        }
+        V::store_records(base, rec, &lo[..n]);
+        V::store_records(base.add(V::LANES * rec), rec, &hi[..n]);
+    }
+    #[inline(always)]
+    fn to_i32s(self, out: &mut [i32]) {
+        self.0[0].to_i32s(out);
+        self.0[1].to_i32s(&mut out[V::LANES..]);
     }
     #[inline(always)]
     unsafe fn load_n(p: *const Self::Scalar, n: usize) -> Self {

@@ -31,7 +31,8 @@
 use crate::error::{Error, Result};
 use crate::lane::Lane;
 use crate::scalar::Real;
-use core::ptr::write_volatile;
+use core::mem::size_of;
+use core::ptr::{addr_of_mut, write_volatile};
 
 /// Most nodes per axis of a stencil (the cubic kernel).
 pub(crate) const MAX_WIDTH: usize = 4;
@@ -255,66 +256,76 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             return 0;
         }
         let mut done = u32::MAX >> (32 - n);
-        // Per axis, the lane vectors `⌊ξ⌋`, `fx` and the K weights and derivatives, stored
-        // and then copied lane by lane into the stencils.
-        let mut fl_buf = [T::ZERO; MAX];
-        let mut fx_buf = [T::ZERO; MAX];
-        let mut w_buf = [[T::ZERO; MAX]; MAX_WIDTH];
-        let mut dw_buf = [[T::ZERO; MAX]; MAX_WIDTH];
+        // Per axis, the lane vectors `⌊ξ⌋` (as integers), `fx` and the K weights and
+        // derivatives, written into the stencils as records (`Lane::store_records`: `f32`
+        // lanes transpose in registers and store whole rows; others store scalars, never
+        // scatter instructions, which are slow on AMD Zen 4).
+        let mut fl_buf = [[0i32; MAX]; 3];
+        let mut lo_bits = [0u32; 3];
+        let zero = V::splat(T::ZERO);
+        let mut fxs = [zero; 3];
+        let mut xa = [T::ZERO; MAX];
         let k = kernel.width();
+        // Scalars per stencil: `Stencil` holds only `T`, `i32` and a one-byte enum, so its
+        // size is a multiple of `T`'s.
+        let rec = size_of::<Self>() / size_of::<T>();
+        debug_assert_eq!(size_of::<Self>() % size_of::<T>(), 0);
+        let first = out.as_mut_ptr();
         for a in 0..D {
-            for (b, x) in fx_buf.iter_mut().zip(xs).take(n) {
+            for (b, x) in xa.iter_mut().zip(xs).take(n) {
                 *b = x[a];
             }
             let shift = match grid {
                 Grid::Face(f) if f != a => T::HALF,
                 _ => T::ZERO,
             };
-            let xi = V::load(&fx_buf[..n]) * V::splat(inv_h) - V::splat(shift);
+            let xi = V::load(&xa[..n]) * V::splat(inv_h) - V::splat(shift);
             // Finite and inside the position limit (false for NaN and infinities).
             done &= V::mask_bits(xi.abs().lt(V::splat(T::from_f64(MAX_CELLS))));
             let fl = xi.floor();
             let frac = xi - fl;
             let one = V::splat(T::ONE);
             // Quadratic: base ⌊ξ − ½⌋ (one less where frac < ½); cubic: ⌊ξ⌋ − 1. Lane `l`'s
-            // `lo` is bit `l` of `lo_bits`.
-            let (lo, lo_bits) = match kernel {
+            // `lo` is bit `l` of `lo_bits[a]` (subtracted as an integer: exact).
+            let lo = match kernel {
                 Kernel::Quadratic => {
                     let below = frac.lt(V::splat(T::HALF));
-                    (
-                        V::select(below, one, V::splat(T::ZERO)),
-                        V::mask_bits(below),
-                    )
+                    lo_bits[a] = V::mask_bits(below);
+                    V::select(below, one, zero)
                 }
-                Kernel::Cubic => (one, u32::MAX),
+                Kernel::Cubic => {
+                    lo_bits[a] = u32::MAX;
+                    one
+                }
             };
             let fx = frac + lo;
-            fl.store(&mut fl_buf[..n]);
-            fx.store(&mut fx_buf[..n]);
+            // Exact where the lane is done (|⌊ξ⌋| < 2³⁰).
+            fl.to_i32s(&mut fl_buf[a]);
+            fxs[a] = fx;
+            // Unused entries are 0, as in `Stencil::new`.
+            let (mut w, mut dw) = ([zero; MAX_WIDTH], [zero; MAX_WIDTH]);
             for o in 0..k {
-                let (w, dw) = kernel.n_dn_lanes(fx - V::splat(T::from_i32(o as i32)));
-                w.store(&mut w_buf[o][..n]);
-                (dw * V::splat(inv_h)).store(&mut dw_buf[o][..n]);
+                let (n, dn) = kernel.n_dn_lanes(fx - V::splat(T::from_i32(o as i32)));
+                w[o] = n;
+                dw[o] = dn * V::splat(inv_h);
             }
-            for (l, st) in out.iter_mut().enumerate().take(n) {
-                let base = (fl_buf[l].to_f64() as i32).wrapping_sub((lo_bits >> l & 1) as i32);
-                // Scalar stores on purpose (volatile, so never vectorised): vectorised over
-                // lanes these copies become scatter instructions (AVX-512), which made the
-                // stencils of a P2G chunk several times slower on AMD Zen 4.
-                // SAFETY: every pointer is a field of `st`, valid for writes.
-                unsafe {
-                    write_volatile(&mut st.base[a], base);
-                    write_volatile(&mut st.fx[a], fx_buf[l]);
-                    for o in 0..MAX_WIDTH {
-                        // Unused entries are 0, as in `Stencil::new`.
-                        let used = o < k;
-                        write_volatile(&mut st.w[a][o], if used { w_buf[o][l] } else { T::ZERO });
-                        write_volatile(&mut st.dw[a][o], if used { dw_buf[o][l] } else { T::ZERO });
-                    }
-                }
+            // SAFETY: `out` holds `n = LANES` stencils; record `l` of `rec` scalars from the
+            // field of `out[0]` is the same field of `out[l]`, and `w[a]`, `dw[a]` are
+            // `MAX_WIDTH` scalars.
+            unsafe {
+                V::store_records(addr_of_mut!((*first).w[a]).cast::<T>(), rec, &w);
+                V::store_records(addr_of_mut!((*first).dw[a]).cast::<T>(), rec, &dw);
             }
         }
-        for st in out.iter_mut().take(n) {
+        // SAFETY: as above; `fx` is `D` scalars.
+        unsafe { V::store_records(addr_of_mut!((*first).fx).cast::<T>(), rec, &fxs[..D]) };
+        for (l, st) in out.iter_mut().enumerate().take(n) {
+            for a in 0..D {
+                let base = fl_buf[a][l].wrapping_sub((lo_bits[a] >> l & 1) as i32);
+                // Volatile, so that the lane loop is not vectorised into scatters.
+                // SAFETY: a field of `st`, valid for writes.
+                unsafe { write_volatile(&mut st.base[a], base) };
+            }
             st.kernel = kernel;
             st.h = h;
         }

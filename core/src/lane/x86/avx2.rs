@@ -32,7 +32,7 @@ vmask!(
 /// The transpose of the 8 × 8 matrix whose rows are `r` (the usual unpack, shuffle,
 /// 128-bit permute sequence: 24 shuffles).
 #[inline(always)]
-unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
+pub(super) unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
     let t0 = _mm256_unpacklo_ps(r[0], r[1]);
     let t1 = _mm256_unpackhi_ps(r[0], r[1]);
     let t2 = _mm256_unpacklo_ps(r[2], r[3]);
@@ -58,6 +58,132 @@ unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
         _mm256_permute2f128_ps::<0x31>(s1, s5),
         _mm256_permute2f128_ps::<0x31>(s2, s6),
         _mm256_permute2f128_ps::<0x31>(s3, s7),
+    ]
+}
+
+/// [`Lane::load_records`] on eight `f32` lanes: blocks of up to eight components, one
+/// (masked) load per record and an 8 × 8 transpose (blocks of three or four: 128-bit loads
+/// and two 4 × 4 transposes); a last one or two components are gathered.
+///
+/// # Safety
+/// As [`Lane::load_records`]; AVX2 available.
+#[inline(always)]
+pub(super) unsafe fn load_records8(base: *const f32, rec: usize, out: &mut [__m256]) {
+    debug_assert!(out.len() <= rec);
+    let mut c0 = 0;
+    while out.len() - c0 >= 3 {
+        let m = (out.len() - c0).min(8);
+        if m <= 4 {
+            // Records `l` and `l + 4` in the two halves, then 4 × 4 transposes.
+            let mut q = [_mm256_setzero_ps(); 4];
+            for (l, x) in q.iter_mut().enumerate() {
+                let (p, p4) = (base.add(rec * l + c0), base.add(rec * (l + 4) + c0));
+                let (lo, hi) = if m == 4 {
+                    (_mm_loadu_ps(p), _mm_loadu_ps(p4))
+                } else {
+                    let k = _mm256_castsi256_si128(mask8(m));
+                    (_mm_maskload_ps(p, k), _mm_maskload_ps(p4, k))
+                };
+                *x = _mm256_insertf128_ps::<1>(_mm256_castps128_ps256(lo), hi);
+            }
+            let t = transpose4x2(q);
+            out[c0..c0 + m].copy_from_slice(&t[..m]);
+        } else {
+            let mut r = [_mm256_setzero_ps(); 8];
+            for (l, x) in r.iter_mut().enumerate() {
+                let p = base.add(rec * l + c0);
+                *x = if m == 8 {
+                    _mm256_loadu_ps(p)
+                } else {
+                    _mm256_maskload_ps(p, mask8(m))
+                };
+            }
+            out[c0..c0 + m].copy_from_slice(&transpose8(r)[..m]);
+        }
+        c0 += m;
+    }
+    for (c, o) in out.iter_mut().enumerate().skip(c0) {
+        *o = F32x8::gather(base.add(c), rec).0;
+    }
+}
+
+/// Writes lanes `0..m` of `x` to `p[0..m]` with plain stores of 4, 2 and 1 lanes (a masked
+/// store, `vmaskmovps`, is several times slower on AMD Zen).
+///
+/// # Safety
+/// `p[0..m]` is valid for writing; `m ≤ 8`.
+#[inline(always)]
+unsafe fn store_first(p: *mut f32, x: __m256, m: usize) {
+    if m == 8 {
+        return _mm256_storeu_ps(p, x);
+    }
+    let (mut rest, mut off, mut r) = (_mm256_castps256_ps128(x), 0, m);
+    if r >= 4 {
+        _mm_storeu_ps(p, rest);
+        (rest, off, r) = (_mm256_extractf128_ps::<1>(x), 4, r - 4);
+    }
+    if r >= 2 {
+        _mm_storeu_si64(p.add(off).cast(), _mm_castps_si128(rest));
+        (rest, off, r) = (_mm_movehl_ps(rest, rest), off + 2, r - 2);
+    }
+    if r == 1 {
+        _mm_store_ss(p.add(off), rest);
+    }
+}
+
+/// [`Lane::store_records`] on eight `f32` lanes: the transposes of [`load_records8`] (each is
+/// its own inverse), plain stores of each record's block; a last one or two
+/// components are stored as scalars.
+///
+/// # Safety
+/// As [`Lane::store_records`]; AVX2 available.
+#[inline(always)]
+pub(super) unsafe fn store_records8(base: *mut f32, rec: usize, vals: &[__m256]) {
+    debug_assert!(vals.len() <= rec);
+    let mut c0 = 0;
+    while vals.len() - c0 >= 3 {
+        let m = (vals.len() - c0).min(8);
+        if m <= 4 {
+            let mut r = [_mm256_setzero_ps(); 4];
+            r[..m].copy_from_slice(&vals[c0..c0 + m]);
+            for (l, x) in transpose4x2(r).iter().enumerate() {
+                store_first(base.add(rec * l + c0), *x, m);
+                let hi = _mm256_castps128_ps256(_mm256_extractf128_ps::<1>(*x));
+                store_first(base.add(rec * (l + 4) + c0), hi, m);
+            }
+        } else {
+            let mut r = [_mm256_setzero_ps(); 8];
+            r[..m].copy_from_slice(&vals[c0..c0 + m]);
+            for (l, x) in transpose8(r).iter().enumerate() {
+                store_first(base.add(rec * l + c0), *x, m);
+            }
+        }
+        c0 += m;
+    }
+    for (c, v) in vals.iter().enumerate().skip(c0) {
+        let mut b = [0.0f32; 8];
+        _mm256_storeu_ps(b.as_mut_ptr(), *v);
+        for (i, x) in b.iter().enumerate() {
+            // Volatile: not merged into a scatter instruction.
+            core::ptr::write_volatile(base.add(i * rec + c), *x);
+        }
+    }
+}
+
+/// The 4 × 4 transposes of the two 128-bit halves of `r` (8 shuffles): with `r[c]` the
+/// component-`c` lanes of eight records, half `h` of output `l` is the first four components
+/// of record `l + 4h`, and the same map takes those back to components.
+#[inline(always)]
+unsafe fn transpose4x2(r: [__m256; 4]) -> [__m256; 4] {
+    let t0 = _mm256_unpacklo_ps(r[0], r[1]);
+    let t1 = _mm256_unpackhi_ps(r[0], r[1]);
+    let t2 = _mm256_unpacklo_ps(r[2], r[3]);
+    let t3 = _mm256_unpackhi_ps(r[2], r[3]);
+    [
+        _mm256_shuffle_ps::<0x44>(t0, t2),
+        _mm256_shuffle_ps::<0xEE>(t0, t2),
+        _mm256_shuffle_ps::<0x44>(t1, t3),
+        _mm256_shuffle_ps::<0xEE>(t1, t3),
     ]
 }
 
@@ -123,56 +249,23 @@ impl Lane for F32x8 {
     }
     #[inline(always)]
     unsafe fn load_records(base: *const f32, rec: usize, out: &mut [Self]) {
-        debug_assert!(out.len() <= rec);
-        // Blocks of up to eight components: one (masked) load per record, an 8 × 8
-        // transpose; a last one or two components are gathered.
-        let mut c0 = 0;
-        while out.len() - c0 >= 3 {
-            let m = (out.len() - c0).min(8);
-            let mut r = [_mm256_setzero_ps(); 8];
-            for (l, x) in r.iter_mut().enumerate() {
-                let p = base.add(rec * l + c0);
-                *x = if m == 8 {
-                    _mm256_loadu_ps(p)
-                } else {
-                    _mm256_maskload_ps(p, mask8(m))
-                };
-            }
-            let t = transpose8(r);
-            for (o, x) in out[c0..c0 + m].iter_mut().zip(t) {
-                *o = F32x8(x);
-            }
-            c0 += m;
-        }
-        for (c, o) in out.iter_mut().enumerate().skip(c0) {
-            *o = Self::gather(base.add(c), rec);
-        }
+        // `F32x8` is `repr(transparent)` around `__m256`.
+        let o = core::slice::from_raw_parts_mut(out.as_mut_ptr().cast::<__m256>(), out.len());
+        load_records8(base, rec, o);
     }
     #[inline(always)]
     unsafe fn store_records(base: *mut f32, rec: usize, vals: &[Self]) {
-        debug_assert!(vals.len() <= rec);
-        let mut c0 = 0;
-        while vals.len() - c0 >= 3 {
-            let m = (vals.len() - c0).min(8);
-            let mut r = [_mm256_setzero_ps(); 8];
-            for (x, v) in r.iter_mut().zip(&vals[c0..c0 + m]) {
-                *x = v.0;
-            }
-            // The transpose is its own inverse: row `l` is record `l`'s block.
-            let t = transpose8(r);
-            for (l, x) in t.iter().enumerate() {
-                let p = base.add(rec * l + c0);
-                if m == 8 {
-                    _mm256_storeu_ps(p, *x);
-                } else {
-                    _mm256_maskstore_ps(p, mask8(m), *x);
-                }
-            }
-            c0 += m;
-        }
-        for (c, v) in vals.iter().enumerate().skip(c0) {
-            v.scatter(base.add(c), rec, u32::MAX);
-        }
+        store_records8(
+            base,
+            rec,
+            core::slice::from_raw_parts(vals.as_ptr().cast(), vals.len()),
+        );
+    }
+    #[inline(always)]
+    fn to_i32s(self, out: &mut [i32]) {
+        let out = &mut out[..8];
+        // SAFETY: `out` holds 8 `i32`; unaligned store.
+        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), _mm256_cvttps_epi32(self.0)) }
     }
     #[inline(always)]
     unsafe fn load_n(p: *const f32, n: usize) -> Self {

@@ -3,6 +3,7 @@
 #![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 
 use super::super::Lane;
+use super::avx2::{load_records8, store_records8};
 use core::arch::x86_64::*;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
@@ -68,7 +69,7 @@ macro_rules! avx512_lane {
      $fmadd:ident, $sqrt:ident, $abs:ident, $cast_i:ident, $cast_f:ident, $and_i:ident,
      $or_i:ident, $andnot_i:ident, $set1_i:ident, $sign:expr, $srli:ident, $sub_i:ident,
      $magic:expr, $rnd:ident, $blend:ident,
-     $cmp:ident, $getexp:ident, $scalef:ident) => {
+     $cmp:ident, $getexp:ident, $scalef:ident, { $($extra:tt)* }) => {
         impl Lane for $v {
             type Scalar = $t;
             type Mask = $k;
@@ -206,8 +207,27 @@ macro_rules! avx512_lane {
                 // SAFETY: see the module docs.
                 unsafe { $v($scalef($set1(1.0), e.0)) }
             }
+            $($extra)*
         }
     };
+}
+
+/// The low and high eight lanes of `v` (AVX-512F instructions only).
+#[inline(always)]
+unsafe fn halves(v: __m512) -> [__m256; 2] {
+    [
+        _mm512_castps512_ps256(v),
+        _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(v))),
+    ]
+}
+
+/// `[lo, hi]` as sixteen lanes.
+#[inline(always)]
+unsafe fn join(lo: __m256, hi: __m256) -> __m512 {
+    _mm512_castpd_ps(_mm512_insertf64x4::<1>(
+        _mm512_castpd256_pd512(_mm256_castps_pd(lo)),
+        _mm256_castps_pd(hi),
+    ))
 }
 
 avx512_lane!(
@@ -241,7 +261,38 @@ avx512_lane!(
     _mm512_mask_blend_ps,
     _mm512_cmp_ps_mask,
     _mm512_getexp_ps,
-    _mm512_scalef_ps
+    _mm512_scalef_ps,
+    {
+        // Records in two halves of eight lanes, each transposed as on AVX2.
+        #[inline(always)]
+        unsafe fn load_records(base: *const f32, rec: usize, out: &mut [Self]) {
+            let n = out.len();
+            let mut lo = [_mm256_setzero_ps(); 32];
+            let mut hi = [_mm256_setzero_ps(); 32];
+            load_records8(base, rec, &mut lo[..n]);
+            load_records8(base.add(8 * rec), rec, &mut hi[..n]);
+            for (o, (l, h)) in out.iter_mut().zip(lo.iter().zip(&hi)) {
+                *o = F32x16(join(*l, *h));
+            }
+        }
+        #[inline(always)]
+        unsafe fn store_records(base: *mut f32, rec: usize, vals: &[Self]) {
+            let n = vals.len();
+            let mut lo = [_mm256_setzero_ps(); 32];
+            let mut hi = [_mm256_setzero_ps(); 32];
+            for (v, (l, h)) in vals.iter().zip(lo.iter_mut().zip(hi.iter_mut())) {
+                [*l, *h] = halves(v.0);
+            }
+            store_records8(base, rec, &lo[..n]);
+            store_records8(base.add(8 * rec), rec, &hi[..n]);
+        }
+        #[inline(always)]
+        fn to_i32s(self, out: &mut [i32]) {
+            let out = &mut out[..16];
+            // SAFETY: `out` holds 16 `i32`; unaligned store.
+            unsafe { _mm512_storeu_si512(out.as_mut_ptr().cast(), _mm512_cvttps_epi32(self.0)) }
+        }
+    }
 );
 
 /// Eight `f64` lanes (AVX-512F).
@@ -291,5 +342,6 @@ avx512_lane!(
     _mm512_mask_blend_pd,
     _mm512_cmp_pd_mask,
     _mm512_getexp_pd,
-    _mm512_scalef_pd
+    _mm512_scalef_pd,
+    {}
 );
