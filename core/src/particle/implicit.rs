@@ -147,26 +147,28 @@ where
     }
 }
 
-/// The slot entries of a prepared particle in slot order (after the tag): `U`, the diagonal
-/// block's upper triangle column by column, the pairs' `(a, b, c)`.
+/// The slot entries of a prepared particle in slot order: `out[o]` for `o` in
+/// `1..slot_len(D)` (0 is the tag's place and is left alone) is `U`, the diagonal block's upper
+/// triangle column by column, the pairs' `(a, b, c)`. (An array, not a callback: a closure is
+/// not compiled with the caller's target features, so lane operations in it would be calls.)
 #[inline(always)]
-pub fn entries<V: Lane, const D: usize>(b: &Blocks<V, D>, mut put: impl FnMut(usize, V)) {
+pub fn entries<V: Lane, const D: usize>(b: &Blocks<V, D>, out: &mut [V; slot_len(3)]) {
     let mut o = 1;
     for j in 0..D {
         for i in 0..D {
-            put(o, b.u[j][i]);
+            out[o] = b.u[j][i];
             o += 1;
         }
     }
     for j in 0..D {
         for i in 0..=j {
-            put(o, b.diag[j][i]);
+            out[o] = b.diag[j][i];
             o += 1;
         }
     }
     for p in b.pair.iter().take(pairs(D)) {
         for x in p {
-            put(o, *x);
+            out[o] = *x;
             o += 1;
         }
     }

@@ -173,20 +173,27 @@ where
                     f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
                 }
             }
-            let [mu, alpha, beta, nv] = [0, 1, 2, 3].map(|k| V::load(&sbuf[k][..lanes]));
+            let [mu, alpha, beta, nv] = [
+                V::load(&sbuf[0][..lanes]),
+                V::load(&sbuf[1][..lanes]),
+                V::load(&sbuf[2][..lanes]),
+                V::load(&sbuf[3][..lanes]),
+            ];
             let (co, ck) = evaluate(mu, &f);
             let b = blocks(&co, alpha, beta, nv, psd);
             let bits = check_bits::<V>(&ck);
-            let mut out = [[T::ZERO; MAX_LANES]; 25];
+            let mut ent = [V::splat(T::ZERO); slot_len(3)];
+            entries(&b, &mut ent);
+            let mut out = [[T::ZERO; MAX_LANES]; slot_len(3)];
             let mut chk = V::splat(T::ZERO);
-            entries(&b, |o, v| {
+            for (o, v) in ent.iter().enumerate().take(sl).skip(1) {
                 // v − v is 0 for finite v and NaN otherwise: one finiteness sum per lane.
                 #[allow(clippy::eq_op)]
                 {
-                    chk += v - v;
+                    chk += *v - *v;
                 }
                 v.store(&mut out[o][..lanes]);
-            });
+            }
             let mut ok_bits = [T::ZERO; MAX_LANES];
             chk.store(&mut ok_bits[..lanes]);
             for l in 0..len {

@@ -299,9 +299,9 @@ fn det_ok<V: Lane, const D: usize>(m: &LMat<V, D>) -> V::Mask {
 }
 
 /// [`liquid_projection`] per lane: `(J_E^{1/d} I, F_P')` with `F_P' = F_P` where `F_P = s I`,
-/// `s > 0` exactly, else `J_P^{1/d} I` (`None`: `F_P` kept on every lane), and the lanes where
-/// both are the scalar results and pass [`check_det`] (`F_P`'s own determinant is checked by
-/// the caller).
+/// `s > 0` exactly or where `liq` is false (a solid keeps its `F_P`), else `J_P^{1/d} I`
+/// (`None`: `F_P` kept on every lane), and the lanes where both are the scalar results and
+/// pass [`check_det`] (`F_P`'s own determinant is checked by the caller).
 ///
 /// [`liquid_projection`]: crate::particle::deformation::liquid_projection
 /// [`check_det`]: crate::particle::deformation::check_det
@@ -309,6 +309,7 @@ fn det_ok<V: Lane, const D: usize>(m: &LMat<V, D>) -> V::Mask {
 fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
     f_e: &LMat<V, D>,
     f_p: &LMat<V, D>,
+    liq: V::Mask,
 ) -> (LMat<V, D>, Option<LMat<V, D>>, V::Mask) {
     let zero = V::splat(T::ZERO);
     let (r_e, ok_e) = root_det(f_e);
@@ -322,17 +323,18 @@ fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
             iso = iso & x.eq(if i == j { s } else { zero });
         }
     }
-    if V::all(iso) {
+    let keep = iso | !liq;
+    if V::all(keep) {
         return (fe, None, ok);
     }
     let (r_p, ok_p) = root_det(f_p);
     let mut fp = diagonal::<V, D>(r_p);
     for (cn, c) in fp.iter_mut().zip(f_p.iter()) {
         for (xn, x) in cn.iter_mut().zip(c.iter()) {
-            *xn = V::select(iso, *x, *xn);
+            *xn = V::select(keep, *x, *xn);
         }
     }
-    ok = ok & (iso | (ok_p & det_ok(&fp)));
+    ok = ok & (keep | (ok_p & det_ok(&fp)));
     (fe, Some(fp), ok)
 }
 
@@ -446,12 +448,11 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     // of both, every lane computes both and takes its own (the other's checks do not apply).
     let (f, f_p_new) = if any_liquid {
         let liq = zero.lt(V::load(&liquid_flags));
-        let (fe, fp, proj_ok) = liquid(&f, &f_p);
+        // The solid lanes' `F_P` is selected inside `liquid`, not by `Option::map` here: a
+        // closure is not compiled with the caller's target features.
+        let (fe, fp, proj_ok) = liquid(&f, &f_p, liq);
         ok = ok & (proj_ok | !liq);
-        (
-            select_mat(liq, &fe, &f),
-            fp.map(|fp| select_mat(liq, &fp, &f_p)),
-        )
+        (select_mat(liq, &fe, &f), fp)
     } else {
         (f, None)
     };

@@ -176,16 +176,27 @@ where
         let outs = &self.outs[..self.na];
         if !tile.add_to_grid::<K>(outs) {
             for m in 0..run.n {
-                // `pre` and `ready` succeeded for this particle before, with these inputs.
-                let r = self.pre(run.idx[m]).and_then(|pre| {
-                    let s = self.stencil(&pre.p.x)?;
-                    let r = self.ready(&pre, run.tau[m], &s)?;
-                    self.scatter::<R, K, N>(&r, oc)
-                });
+                let r = self.rescatter::<R, K, N>(run.idx[m], run.tau[m], oc);
                 self.first.note(run.idx[m], r);
             }
         }
         run.n = 0;
+    }
+
+    /// Particle `i` of a flushed run (with its `τ` deviator) scatter-added on its own.
+    /// `pre` and `ready` succeeded for this particle before, with these inputs. (A method, not
+    /// a closure: a closure is not compiled with the caller's target features.)
+    #[inline(always)]
+    unsafe fn rescatter<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &self,
+        i: usize,
+        tau_dev: Mat<T, D>,
+        oc: &[[T; N]; D],
+    ) -> Result<()> {
+        let pre = self.pre(i)?;
+        let s = self.stencil(&pre.p.x)?;
+        let r = self.ready(&pre, tau_dev, &s)?;
+        self.scatter::<R, K, N>(&r, oc)
     }
 
     #[inline(always)]
