@@ -4,8 +4,9 @@
 //! 1. `p2g`: P2G equals the per-particle reference (`update::p2g` and `P2g::node`, accumulated
 //!    in f64) within the rounding of the SIMD stress (bounded in tests/batch.rs) and of the
 //!    sums; interleaved node structs give the same bits as separate arrays; a particle's
-//!    contribution does not depend on its index in the batch. MAC P2G conserves mass and
-//!    momentum on every face grid and its forces sum to zero.
+//!    contribution does not depend on its index in the batch (for every material: the
+//!    per-particle pass on lanes gives the bits of the one-by-one pass). MAC P2G conserves
+//!    mass and momentum on every face grid and its forces sum to zero.
 //! 2. `g2p`: G2P equals the per-particle reference (`g2p_update` on the gathered stencil
 //!    values); on a linear velocity field (collocated and MAC) it reproduces `v = v₀ + A x`,
 //!    `C = A`, `∇v = A` (B-splines reproduce linear functions; an independent check of the node

@@ -260,6 +260,90 @@ fn layouts_and_positions_give_the_same_bits() {
     }
 }
 
+/// A particle's contribution has the same bits alone and at any index of a batch, for every
+/// material, with the impulse term and (with heat) the heat channels: in a batch, whole groups
+/// of eight particles take their per-particle pass (reads, checks, moduli, stress factors) on
+/// lanes, and a particle alone takes it on its own. The batch's other particles are ≥ 4 cells
+/// away along axis 0 (disjoint stencils); one of them is invalid, so that its group of eight
+/// takes the pass one by one.
+fn batch_index_independent<T: BatchReal, const D: usize>()
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+    DefaultSvd: SvdMethod<Mat<T, D>>,
+{
+    let (cells, hf) = (12, 0.05);
+    let h = T::from_f64(hf);
+    let (lo, dims) = ([-1; D], [cells + 2; D]);
+    let args = P2gArgs {
+        kernel: Kernel::Quadratic,
+        grid: Grid::Collocated,
+        h,
+        impulse_dt: T::from_f64(1e-4),
+    };
+    for (name, mat) in materials::<T>() {
+        let mut rng = Pcg64::seed_from_u64(5);
+        let mut near = particles::<T, D>(&mut rng, 40, hf, cells, &mat);
+        for q in near.iter_mut() {
+            let c = q.x[0] / h;
+            q.x[0] = T::from_f64(4.0) * h + (c - c.floor()) * h;
+        }
+        // Particle 33 (group 32..40) has a NaN velocity.
+        near[33].v[0] = T::from_f64(f64::NAN);
+        for isa in Isa::available() {
+            for k in [0usize, 5, 17, 31, 36, 39] {
+                let mut p = near[k];
+                p.x[0] += T::from_f64(5.0) * h;
+                let mut batch = near.clone();
+                batch[k] = p;
+                let mut s1 = Store::from(&[p]);
+                let mut g1 = DenseGrid::<T, D>::new(lo, dims);
+                // SAFETY: one particle; the channels cover the box.
+                let st = unsafe { p2g::p2g(isa, &mat, &args, 1, &s1.raw(), &g1.p2g_view()) };
+                assert_eq!(st.error, None, "{name} {isa:?} alone");
+                let mut sb = Store::from(&batch);
+                let mut gb = DenseGrid::<T, D>::new(lo, dims);
+                // SAFETY: as above.
+                let st =
+                    unsafe { p2g::p2g(isa, &mat, &args, batch.len(), &sb.raw(), &gb.p2g_view()) };
+                assert_eq!(
+                    (st.first_failed, st.error),
+                    (33, Some(Error::NonFinite)),
+                    "{name} {isa:?} batch"
+                );
+                let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &p.x).unwrap();
+                let mut written = false;
+                for nd in s.nodes() {
+                    let ix = g1.index(nd.index);
+                    for c in 0..CH {
+                        written |= g1.ch[c][ix] != T::ZERO;
+                        assert_eq!(
+                            g1.ch[c][ix].to_f64().to_bits(),
+                            gb.ch[c][ix].to_f64().to_bits(),
+                            "{name} {isa:?} {D}D particle at batch index {k}, channel {c}"
+                        );
+                    }
+                }
+                assert!(written, "{name} {isa:?}: the particle wrote its nodes");
+            }
+        }
+    }
+}
+
+#[test]
+fn batch_index_independent_2d_f32() {
+    batch_index_independent::<f32, 2>();
+}
+#[test]
+fn batch_index_independent_3d_f32() {
+    batch_index_independent::<f32, 3>();
+}
+#[test]
+fn batch_index_independent_3d_f64() {
+    batch_index_independent::<f64, 3>();
+}
+
 /// MAC P2G: on every face grid, node masses sum to the particle masses, momentum component
 /// `a` to `Σ m v_a` (APIC adds `m C Σ w (x_i − x_p) = 0`), and the forces to zero
 /// (`Σ ∇w_i = 0`), each within the rounding of its sum.

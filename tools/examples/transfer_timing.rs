@@ -1,6 +1,7 @@
-//! Quick split timing of P2G, G2P and the force differential's apply (3D f32 quadratic): `cargo run --release -p ampm-tools
-//! --example transfer_timing -- <fluid|elastic|thermal>` (a development aid; the benchmark is
-//! `tools/benches/particle_levels.rs`).
+//! Quick split timing of P2G, G2P and the force differential's apply (f32 quadratic, 3D, or 2D
+//! with `AMPM_TT_DIM=2`): `cargo run --release -p ampm-tools --example transfer_timing --
+//! <fluid|elastic|thermal>` (a development aid; the benchmarks are `c_tests/bench_transfers`
+//! and `tools/benches/particle_levels.rs`).
 use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
 use ampm_core::particle::transfer::force::{self, ForceView};
@@ -33,14 +34,28 @@ impl Cpu {
 }
 
 fn main() {
-    const D: usize = 3;
+    match std::env::var("AMPM_TT_DIM").as_deref() {
+        Ok("2") => run::<2>(),
+        _ => run::<3>(),
+    }
+}
+
+/// The timing loop in `D` dimensions.
+fn run<const D: usize>()
+where
+    ampm_core::kernel::Dim<D>: ampm_core::kernel::LaneDim<D>,
+    ampm_core::mat::Mat<f32, D>: ampm_core::mat::Matrix<Scalar = f32, Vector = [f32; D]>,
+    ampm_core::polar::DefaultSvd: ampm_core::polar::SvdMethod<ampm_core::mat::Mat<f32, D>>,
+{
+    let dd = D * D;
     let level = std::env::args().nth(1).unwrap_or_else(|| "elastic".into());
     let liquid = level == "fluid";
     // `thermal`: the elastic level with heat and phase change (solids at 270 K, melting at
     // 273.15 K).
     let thermal = level == "thermal";
-    let s = 38usize;
-    let n = s * s * s;
+    // 54,872 particles in 3D, 262,144 in 2D.
+    let s = if D == 3 { 38usize } else { 512 };
+    let n = s.pow(D as u32);
     let h = 0.02f32;
     // A lattice at spacing h/2, shuffled and then sorted by cell (x fastest), as a host and
     // the C++ benchmark order their particles.
@@ -52,7 +67,15 @@ fn main() {
         g ^= g << 17;
         order.swap(i, (g % (i as u64 + 1)) as usize);
     }
-    let key = |i: usize| (i % s / 2) + s * ((i / s % s / 2) + s * (i / (s * s) / 2));
+    let key = |i: usize| {
+        let (mut q, mut k, mut m) = (i, 0, 1);
+        for _ in 0..D {
+            k += q % s / 2 * m;
+            q /= s;
+            m *= s;
+        }
+        k
+    };
     order.sort_by_key(|&i| key(i));
     let mut x = Vec::new();
     for &i in &order {
@@ -63,16 +86,16 @@ fn main() {
         }
     }
     let mut v = vec![0.01f32; n * D];
-    let mut affine = vec![0.0f32; n * 9];
-    let mut f_e = vec![0.0f32; n * 9];
-    let mut f_p = vec![0.0f32; n * 9];
+    let mut affine = vec![0.0f32; n * dd];
+    let mut f_e = vec![0.0f32; n * dd];
+    let mut f_p = vec![0.0f32; n * dd];
     for i in 0..n {
         for d in 0..D {
-            f_e[9 * i + 4 * d] = if liquid { 1.0 } else { 1.0 + 0.01 * (d as f32) };
-            f_p[9 * i + 4 * d] = 1.0;
+            f_e[dd * i + (D + 1) * d] = if liquid { 1.0 } else { 1.0 + 0.01 * (d as f32) };
+            f_p[dd * i + (D + 1) * d] = 1.0;
         }
         if !liquid {
-            f_e[9 * i + 1] = 0.02;
+            f_e[dd * i + 1] = 0.02;
         }
     }
     let mass = vec![1e-3f32; n];
@@ -111,7 +134,10 @@ fn main() {
     };
     let dims = [(s / 2 + 8) as i32; D];
     let nn: usize = dims.iter().map(|&d| d as usize).product();
-    let stride = [1, dims[0] as isize, (dims[0] * dims[1]) as isize];
+    let mut stride = [1isize; D];
+    for a in 1..D {
+        stride[a] = stride[a - 1] * dims[a - 1] as isize;
+    }
     // Mass, momentum (3), heat capacity, thermal energy, conductivity, temperatures new, old.
     let mut grid = vec![vec![0.0f32; nn]; 9];
     let nodes = NodeBox { lo: [0; D], dims };
@@ -171,11 +197,11 @@ fn main() {
                 .for_each(|c| c.iter_mut().for_each(|x| *x = 0.0));
             let fv = ForceView {
                 nodes,
-                du: [0, 1, 2].map(|c| Channel {
+                du: std::array::from_fn(|c| Channel {
                     data: du[c].as_ptr(),
                     stride,
                 }),
-                df: [0, 1, 2].map(|c| Channel {
+                df: std::array::from_fn(|c| Channel {
                     data: df[c].as_mut_ptr(),
                     stride,
                 }),
@@ -204,8 +230,8 @@ fn main() {
                     data: grid[0].as_mut_ptr(),
                     stride,
                 },
-                momentum: [1, 2, 3].map(|c| Channel {
-                    data: grid[c].as_mut_ptr(),
+                momentum: std::array::from_fn(|c| Channel {
+                    data: grid[1 + c].as_mut_ptr(),
                     stride,
                 }),
                 force: [Channel::<*mut f32, D>::none(); D],
@@ -220,13 +246,13 @@ fn main() {
             assert_eq!(st.error, None);
             grid[7].iter_mut().for_each(|x| *x = 270.0);
             grid[8].iter_mut().for_each(|x| *x = 269.9);
-            for c in 1..4 {
+            for c in 1..=D {
                 grid[c].iter_mut().for_each(|x| *x = 1e-3);
             }
             let gv = G2pView {
                 nodes,
-                velocity: [1, 2, 3].map(|c| Channel {
-                    data: grid[c].as_ptr(),
+                velocity: std::array::from_fn(|c| Channel {
+                    data: grid[1 + c].as_ptr(),
                     stride,
                 }),
                 temperature: temp_ch(&grid, 7),
@@ -245,7 +271,8 @@ fn main() {
             best = (best.0.min(t1), best.1.min(t2), best.2.min(t3));
         }
         println!(
-            "{level} {}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
+            "{level}{} {}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
+            if D == 2 { " 2d" } else { "" },
             isa.name(),
             best.0 / n as f64 * 1e9,
             best.1 / n as f64 * 1e9,

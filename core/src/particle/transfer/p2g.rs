@@ -8,9 +8,10 @@
 //!   the dilation is explicit; `Â` only when `μ > 0`, so a liquid runs no decomposition);
 //! - heat capacity `w m c`, thermal energy `w m c T`, conductivity mass `w m κ` (heat on).
 //!
-//! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]); the
-//! node values of a run of nearby particles are summed in a node tile (`transfer/tile.rs`) that is
-//! added to the grid once per run (the loops: `p2g/run.rs`).
+//! The stresses of a chunk of particles are computed on SIMD lanes ([`crate::kernel`]), and so
+//! are the reads, checks and per-particle factors of each whole group of eight
+//! (`p2g/lanes.rs`); the node values of a run of nearby particles are summed in a node tile
+//! (`transfer/tile.rs`) that is added to the grid once per run (the loops: `p2g/run.rs`).
 
 use super::nodes::taint;
 use super::tile::{MAX_CH, MAX_RUN};
@@ -308,4 +309,5 @@ where
     }
 }
 
+mod lanes;
 mod run;

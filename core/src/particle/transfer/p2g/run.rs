@@ -1,7 +1,9 @@
-//! P2G's node loops: the chunked particle loop (stresses and stencils on SIMD lanes), the node
-//! tile of a run of nearby particles (`transfer/tile.rs`) and its flush into the grid, and the
-//! one-particle scatter that a run whose sums overflow falls back to.
+//! P2G's node loops: the chunked particle loop (stresses, stencils and the per-particle pass on
+//! SIMD lanes, `p2g/lanes.rs`), the node tile of a run of nearby particles (`transfer/tile.rs`)
+//! and its flush into the grid, and the one-particle scatter that a run whose sums overflow
+//! falls back to.
 
+use super::lanes::{fm_lanes, ChunkBufs};
 use super::{P2gOp, Pre, Ready, Run};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, MAX_LANES};
@@ -16,7 +18,12 @@ use crate::particle::transfer::nodes::{
 };
 use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use crate::particle::transfer::BatchStatus;
+use crate::particle::Dilation;
 use core::mem::MaybeUninit;
+
+/// Where a particle's pass is: its scalar pass, or its lane of the chunk's buffers (when that
+/// ran on lanes); and its position.
+type Source<'b, T, const D: usize> = (&'b Pre<T, D>, Option<(&'b ChunkBufs<T>, usize)>, &'b [T; D]);
 
 impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
 where
@@ -199,16 +206,18 @@ where
         self.scatter::<R, K, N>(&r, oc)
     }
 
+    /// Adds particle `i` with deviatoric stress `tau_dev` to the tile run: its scalar pass
+    /// `pre`, or its lane of the chunk's `ChunkBufs` when its pass ran on lanes;
+    /// `x` its position; `lane_stencil` its stencil if the lanes made it.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
         i: usize,
-        pre: &Pre<T, D>,
+        (pre, from_lanes, x): Source<'_, T, D>,
         tau_dev: Mat<T, D>,
         lane_stencil: Option<&Stencil<T, D>>,
-        tile: &mut Tile<R, D>,
-        run: &mut Run<T, D>,
+        (tile, run): (&mut Tile<R, D>, &mut Run<T, D>),
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) {
@@ -216,7 +225,7 @@ where
         let own;
         let s = match lane_stencil {
             Some(s) => s,
-            None => match self.stencil(&pre.p.x) {
+            None => match self.stencil(x) {
                 Ok(s) => {
                     own = s;
                     &own
@@ -224,7 +233,11 @@ where
                 Err(e) => return self.first.note(i, Err(e)),
             },
         };
-        let r = match self.ready(pre, tau_dev, s) {
+        let ready = match from_lanes {
+            Some((b, l)) => self.ready_lane(b, l, s),
+            None => self.ready(pre, tau_dev, s),
+        };
+        let r = match ready {
             Err(e) => Err(e),
             Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc, coef),
         };
@@ -273,8 +286,13 @@ where
             tau: [Mat::ZERO; MAX_RUN],
         };
         let lanes = V::LANES;
-        // The chunk's scalar passes, built in place (see `pre_into`); `live[l]` when lane
-        // `l`'s succeeded.
+        // The chunk's per-particle data on lanes (see `p2g/lanes.rs`); bit `l` of `fast` when
+        // lane `l`'s pass ran on lanes.
+        let mut b = ChunkBufs::<T>::new();
+        let on_lanes = self.lanes_ok();
+        let explicit = self.material.dilation == Dilation::Explicit;
+        // The scalar passes of the other lanes, built in place (see `pre_into`); `live[l]`
+        // when lane `l`'s succeeded.
         let mut pres = [Pre::<T, D>::blank(); MAX_LANES];
         let mut live = [false; MAX_LANES];
         // The chunk's positions and stencils (on lanes, see `Stencil::new_lanes`).
@@ -284,60 +302,78 @@ where
         let mut start = 0;
         while start < self.n {
             let len = lanes.min(self.n - start);
-            let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
-            let mut mubuf = [T::ZERO; MAX_LANES];
             let mut any_mu = false;
-            for l in 0..len {
+            let mut fast = 0u32;
+            let mut g = 0;
+            while g < len {
+                let gl = R::LANES.min(len - g);
                 // SAFETY: `p2g`'s contract: the arrays hold `n` particles.
-                live[l] = false;
-                match unsafe { self.pre_into(start + l, &mut pres[l]) } {
-                    Ok(()) => {
-                        let pr = &pres[l];
-                        for j in 0..D {
-                            for r in 0..D {
-                                fbuf[r + D * j][l] = pr.p.f_e.cols[j][r];
-                            }
-                        }
-                        mubuf[l] = pr.mu;
-                        any_mu |= pr.mu > T::ZERO;
-                        live[l] = true;
+                let pass = match on_lanes && gl == R::LANES {
+                    true => unsafe { self.pre_lanes::<R>(start + g, g, &mut b, &mut xs) },
+                    false => None,
+                };
+                if let Some(mu) = pass {
+                    any_mu |= mu;
+                    fast |= ((1u32 << gl) - 1) << g;
+                    for lv in &mut live[g..g + gl] {
+                        *lv = true;
                     }
-                    Err(e) => self.first.note(start + l, Err(e)),
+                    g += gl;
+                    continue;
                 }
+                for l in g..g + gl {
+                    live[l] = false;
+                    b.blank_lane::<D>(l);
+                    // SAFETY: as above.
+                    match unsafe { self.pre_into(start + l, &mut pres[l]) } {
+                        Ok(()) => {
+                            let pr = &pres[l];
+                            for j in 0..D {
+                                for r in 0..D {
+                                    b.f[r + D * j][l] = pr.p.f_e.cols[j][r];
+                                }
+                            }
+                            b.mu[l] = pr.mu;
+                            any_mu |= pr.mu > T::ZERO;
+                            xs[l] = pr.p.x;
+                            live[l] = true;
+                        }
+                        Err(e) => self.first.note(start + l, Err(e)),
+                    }
+                }
+                g += gl;
             }
             for l in len..lanes {
-                for d in 0..D {
-                    fbuf[d * (D + 1)][l] = T::ONE;
-                }
-            }
-            for (x, pr) in xs.iter_mut().zip(&pres).take(len) {
-                *x = pr.p.x;
+                b.blank_lane::<D>(l);
             }
             let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils);
-            let mut tbuf = [[T::ZERO; MAX_LANES]; 9];
             let mut lane_err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
+            let mut tau: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
             if any_mu {
-                // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
                 let mut f: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
                 for j in 0..D {
                     for r in 0..D {
-                        f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
+                        f[j][r] = V::load(&b.f[r + D * j][..lanes]);
                     }
                 }
-                let (co, ck) = evaluate(V::load(&mubuf[..lanes]), &f);
-                let tau = mul_nt(&ahat(&co), &f);
-                for j in 0..D {
-                    for r in 0..D {
-                        tau[j][r].store(&mut tbuf[r + D * j][..lanes]);
-                    }
-                }
+                let (co, ck) = evaluate(V::load(&b.mu[..lanes]), &f);
+                tau = mul_nt(&ahat(&co), &f);
                 let bits = check_bits::<V>(&ck);
                 for (l, e) in lane_err.iter_mut().enumerate().take(len) {
                     // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                    if mubuf[l] > T::ZERO {
+                    if b.mu[l] > T::ZERO {
                         *e = lane_error(&bits, l);
                     }
                 }
+            }
+            for j in 0..D {
+                for r in 0..D {
+                    tau[j][r].store(&mut b.tau[r + D * j][..lanes]);
+                }
+            }
+            if fast != 0 {
+                fm_lanes(&mut b, &tau, explicit, lanes);
             }
             for l in 0..len {
                 if live[l] {
@@ -348,18 +384,18 @@ where
                     let mut tau = Mat::<T, D>::ZERO;
                     for j in 0..D {
                         for r in 0..D {
-                            tau.cols[j][r] = tbuf[r + D * j][l];
+                            tau.cols[j][r] = b.tau[r + D * j][l];
                         }
                     }
+                    let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
                         self.finish::<R, K, N>(
                             start + l,
-                            &pres[l],
+                            (&pres[l], from_lanes, &xs[l]),
                             tau,
                             (done >> l & 1 == 1).then_some(&stencils[l]),
-                            &mut tile,
-                            &mut run,
+                            (&mut tile, &mut run),
                             &oc,
                             &mut coef,
                         )
