@@ -263,7 +263,7 @@ fn layouts_and_positions_give_the_same_bits() {
 /// A particle's contribution has the same bits alone and at any index of a batch, for every
 /// material, with the impulse term and (with heat) the heat channels: in a batch, whole groups
 /// of eight particles take their per-particle pass (reads, checks, moduli, stress factors) on
-/// lanes, and a particle alone takes it on its own. The batch's other particles are ≥ 4 cells
+/// lanes in f32, and a particle alone takes it on its own. The batch's other particles are ≥ 4 cells
 /// away along axis 0 (disjoint stencils); one of them is invalid, so that its group of eight
 /// takes the pass one by one.
 fn batch_index_independent<T: BatchReal, const D: usize>()
