@@ -157,6 +157,22 @@ struct P2gOp<'a, T, const D: usize> {
     na: usize,
 }
 
+/// The momentum density at a stencil's offset 0, `q₀ = m v − (m C h) fx` (the particle's
+/// `m v`, `m C h` and stencil `fx`), summed from zero in index order: the one formula of the
+/// scalar pass and of the pass on lanes (`p2g/lanes.rs`), so that both give the same bits.
+#[inline(always)]
+fn momentum0<T: Real, const D: usize>(mv: &[T; D], mch: &Mat<T, D>, fx: &[T; D]) -> [T; D] {
+    let mut q0 = [T::ZERO; D];
+    for r in 0..D {
+        let mut c = T::ZERO;
+        for b in 0..D {
+            c += mch.cols[b][r] * fx[b];
+        }
+        q0[r] = mv[r] - c;
+    }
+    q0
+}
+
 /// What the scalar pass knows about a particle before its stress.
 #[derive(Clone, Copy)]
 struct Pre<T, const D: usize> {
@@ -242,14 +258,11 @@ where
         }
         let fm = tau * (-p.volume0);
         let mch = p.affine * (p.mass * a.h);
-        let mut q0 = [T::ZERO; D];
+        let mut mv = [T::ZERO; D];
         for r in 0..D {
-            let mut c = T::ZERO;
-            for b in 0..D {
-                c += mch.cols[b][r] * s.fx[b];
-            }
-            q0[r] = p.mass * p.v[r] - c;
+            mv[r] = p.mass * p.v[r];
         }
+        let q0 = momentum0(&mv, &mch, &s.fx);
         let heat = match &self.material.heat {
             Some(_) => {
                 let pp = self.material.params(p.phase);

@@ -13,7 +13,7 @@
 //! (the `Ready` check) marks only its own particle, which then fails with
 //! [`Error::Overflow`] as in the scalar pass.
 
-use super::{P2gOp, Ready};
+use super::{momentum0, P2gOp, Ready};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{BatchReal, MAX_LANES};
 use crate::lane::lmat::{self, LMat};
@@ -255,16 +255,14 @@ where
                 mch.cols[j][i] = b.mch[i + D * j][l];
             }
         }
-        // As `ready`: `q₀ = m v − Σ_b (mCh)_{·b} fx_b`, the sum from 0.
-        let mut q0 = [T::ZERO; D];
+        let mut mv = [T::ZERO; D];
+        for (r, m) in mv.iter_mut().enumerate() {
+            *m = b.mv[r][l];
+        }
+        let q0 = momentum0(&mv, &mch, &s.fx);
         let mut chk = b.finite >> l & 1 == 1;
-        for r in 0..D {
-            let mut c = T::ZERO;
-            for bb in 0..D {
-                c += mch.cols[bb][r] * s.fx[bb];
-            }
-            q0[r] = b.mv[r][l] - c;
-            taint(&mut chk, q0[r]);
+        for x in q0 {
+            taint(&mut chk, x);
         }
         let heat = [b.heat[0][l], b.heat[1][l], b.heat[2][l]];
         if !chk {
