@@ -192,6 +192,20 @@ pub trait Lane:
     #[must_use]
     fn pow2(e: Self) -> Self;
 
+    /// [`Real::cbrt`] lane by lane, with its bits on every path: by default the scalar
+    /// function per lane; the eight-lane `f32` type evaluates the same algorithm (libm's
+    /// `cbrtf`, from FreeBSD's `s_cbrtf.c`) on lanes.
+    #[inline(always)]
+    #[must_use]
+    fn cbrt(self) -> Self {
+        let mut a = [Self::Scalar::ZERO; 32];
+        self.store(&mut a);
+        for x in a.iter_mut().take(Self::LANES) {
+            *x = Real::cbrt(*x);
+        }
+        Self::load(&a)
+    }
+
     /// `1/√self` for a positive normal `self`, to a few ulps. Vector paths: the Newton
     /// iteration [`lmat::rsqrt_newton`] (no division or square-root instruction, whose
     /// throughput would dominate the kernels); scalars: `1/√x` with the correctly rounded
@@ -584,6 +598,10 @@ impl<V: Lane> Lane for X2<V> {
     fn to_i32s(self, out: &mut [i32]) {
         self.0[0].to_i32s(out);
         self.0[1].to_i32s(&mut out[V::LANES..]);
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        X2([self.0[0].cbrt(), self.0[1].cbrt()])
     }
     #[inline(always)]
     unsafe fn load_n(p: *const Self::Scalar, n: usize) -> Self {

@@ -112,6 +112,69 @@ fn all<V: Lane>() {
 
 use crate::scalar::Real;
 
+/// `Lane::cbrt` has the bits of [`Real::cbrt`] (libm's `cbrtf`) on every lane: every `f32`
+/// in [1, 8) (three binades, every residue of the exponent mod 3) and every positive
+/// subnormal, every 7th of their negatives, zeros, infinities, NaN, and every 251st bit
+/// pattern of the whole range.
+fn cbrt_bits<V: Lane<Scalar = f32>>() {
+    let check = |start: u32, end: u32, step: u32| {
+        let mut i = start;
+        while i < end {
+            let xs: [f32; 32] = core::array::from_fn(|l| {
+                f32::from_bits(i.saturating_add(step.saturating_mul(l as u32)).min(end - 1))
+            });
+            let mut got = [0.0f32; 32];
+            V::load(&xs).cbrt().store(&mut got);
+            for (x, g) in xs.iter().zip(&got).take(V::LANES) {
+                let want = Real::cbrt(*x);
+                assert_eq!(
+                    g.to_bits(),
+                    want.to_bits(),
+                    "cbrt({x:e}) bits {:#x}",
+                    x.to_bits()
+                );
+            }
+            i = i.saturating_add(step.saturating_mul(V::LANES as u32));
+            if i == u32::MAX {
+                break;
+            }
+        }
+    };
+    let (one, eight) = (1.0f32.to_bits(), 8.0f32.to_bits());
+    check(one, eight, 1);
+    check(one | 1 << 31, eight | 1 << 31, 7);
+    check(0, 0x0080_0000, 1);
+    check(1 << 31, (1 << 31) | 0x0080_0000, 7);
+    check(0, u32::MAX, 251);
+    let special = [
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        -f32::NAN,
+        0.0,
+        -0.0,
+    ];
+    for x in special {
+        check(x.to_bits(), x.to_bits() + 1, 1);
+    }
+}
+
+#[test]
+fn cbrt_has_the_scalar_bits() {
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn avx2() {
+            cbrt_bits::<super::F32x8>();
+            cbrt_bits::<X2<super::F32x8>>();
+        }
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX2 and FMA.
+            unsafe { avx2() };
+        }
+    }
+}
+
 #[test]
 fn partial_and_record_loads_and_stores() {
     all::<f32>();

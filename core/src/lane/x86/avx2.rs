@@ -388,6 +388,81 @@ impl Lane for F32x8 {
             F32x8(_mm256_castsi256_ps(_mm256_slli_epi32::<23>(i)))
         }
     }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        // SAFETY: see the module docs.
+        unsafe { F32x8(cbrt8(self.0)) }
+    }
+}
+
+/// libm's `cbrtf` (FreeBSD `s_cbrtf.c`) on eight lanes, the same operations in the same
+/// order: the first guess `t₀` from the bits (`|x|`'s bits / 3 + B1, or for a subnormal those
+/// of `x·2²⁴` / 3 + B2, with `x`'s sign), then two Newton steps
+/// `t ← t (x + x + t³) / (x + t³ + t³)` in `f64` from `x` itself, rounded to `f32` (to
+/// nearest, as `as f32`); `±0` and non-finite `x` as `cbrtf` (`x`, `x + x`). The integer
+/// quotient `bits / 3` is `⌊bits / 3.0⌋` in `f64`: exact, since `bits < 2³¹` and `bits/3` is
+/// an integer or at least 1/3 away from one.
+///
+/// # Safety
+/// AVX2 available.
+#[inline(always)]
+unsafe fn cbrt8(x: __m256) -> __m256 {
+    const B1: i32 = 709_958_130;
+    const B2: i32 = 642_849_266;
+    let bits = _mm256_castps_si256(x);
+    let sign = _mm256_and_si256(bits, _mm256_set1_epi32(i32::MIN));
+    let hx = _mm256_and_si256(bits, _mm256_set1_epi32(i32::MAX));
+    let sub = _mm256_cmpgt_epi32(_mm256_set1_epi32(0x0080_0000), hx);
+    let scaled = _mm256_castps_si256(_mm256_mul_ps(x, _mm256_set1_ps(16_777_216.0)));
+    let hs = _mm256_and_si256(scaled, _mm256_set1_epi32(i32::MAX));
+    let h = _mm256_blendv_epi8(hx, hs, sub);
+    let b = _mm256_blendv_epi8(_mm256_set1_epi32(B1), _mm256_set1_epi32(B2), sub);
+    let quot = _mm256_set_m128i(
+        third4(_mm256_extracti128_si256::<1>(h)),
+        third4(_mm256_castsi256_si128(h)),
+    );
+    let t0 = _mm256_castsi256_ps(_mm256_or_si256(sign, _mm256_add_epi32(quot, b)));
+    // Helper functions, not closures: a closure is not compiled with the caller's target
+    // features.
+    let lo = newton4(_mm256_castps256_ps128(t0), _mm256_castps256_ps128(x));
+    let hi = newton4(
+        _mm256_extractf128_ps::<1>(t0),
+        _mm256_extractf128_ps::<1>(x),
+    );
+    let y = _mm256_set_m128(hi, lo);
+    // hx ≥ 0x7f800000 (NaN, ±∞): x + x; hx = 0 (±0): x.
+    let special = _mm256_cmpgt_epi32(hx, _mm256_set1_epi32(0x7f7f_ffff));
+    let zero = _mm256_cmpeq_epi32(hx, _mm256_setzero_si256());
+    let y = _mm256_blendv_ps(y, _mm256_add_ps(x, x), _mm256_castsi256_ps(special));
+    _mm256_blendv_ps(y, x, _mm256_castsi256_ps(zero))
+}
+
+/// `⌊v / 3⌋` of four non-negative 32-bit integers, through `f64` (exact, see [`cbrt8`]).
+///
+/// # Safety
+/// AVX2 available.
+#[inline(always)]
+unsafe fn third4(v: __m128i) -> __m128i {
+    let d = _mm256_div_pd(_mm256_cvtepi32_pd(v), _mm256_set1_pd(3.0));
+    _mm256_cvttpd_epi32(_mm256_floor_pd(d))
+}
+
+/// The two Newton steps of [`cbrt8`] on four lanes: guess `t`, argument `x`.
+///
+/// # Safety
+/// AVX2 available.
+#[inline(always)]
+unsafe fn newton4(t: __m128, x: __m128) -> __m128 {
+    let xd = _mm256_cvtps_pd(x);
+    let mut t = _mm256_cvtps_pd(t);
+    for _ in 0..2 {
+        // r = t·t·t; t = t·(x + x + r) / (x + r + r), left to right as in C.
+        let r = _mm256_mul_pd(_mm256_mul_pd(t, t), t);
+        let num = _mm256_add_pd(_mm256_add_pd(xd, xd), r);
+        let den = _mm256_add_pd(_mm256_add_pd(xd, r), r);
+        t = _mm256_div_pd(_mm256_mul_pd(t, num), den);
+    }
+    _mm256_cvtpd_ps(t)
 }
 
 /// Four `f64` lanes (AVX2 + FMA).

@@ -86,7 +86,7 @@ unsafe fn gather_mat<T: Real, V: Lane<Scalar = T>, const D: usize>(
     start: usize,
 ) -> LMat<V, D> {
     let z = V::splat(T::ZERO);
-    let mut e = [z; 9];
+    let mut e = [z; MAX_D * MAX_D];
     V::load_records(p.add(D * D * start), D * D, &mut e[..D * D]);
     let mut m = lmat::zero::<V, D>();
     for j in 0..D {
@@ -217,7 +217,7 @@ unsafe fn heat_chunk<T: Real>(
 /// where it is that root: finite `M` whose column maxima are normal and below `2^{bias−1}`
 /// (so every scaling is one multiplication by a normal power of two, as `scalbn` does it in that
 /// range), `det M̂ > 0`, and a finite positive root. The square root is correctly rounded on
-/// every path; the cube root is the scalar [`Real::cbrt`] of each lane.
+/// every path; the cube root has the bits of the scalar [`Real::cbrt`] ([`Lane::cbrt`]).
 ///
 /// [`root_det`]: crate::particle::deformation::root_det
 #[inline(always)]
@@ -250,16 +250,7 @@ fn root_det<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> (V,
     let q = (e / d).floor();
     let rho = e - d * q;
     let y = det * V::pow2(rho);
-    let root = if D == 2 {
-        y.sqrt()
-    } else {
-        let mut a = [T::ZERO; LANES];
-        y.store(&mut a);
-        for x in a.iter_mut() {
-            *x = x.cbrt();
-        }
-        V::load(&a)
-    };
+    let root = if D == 2 { y.sqrt() } else { y.cbrt() };
     // |q| ≤ bias − 1 by the column bounds: one multiplication, as `scalbn`.
     let r = root * V::pow2(q);
     (r, ok & r.is_finite() & zero.lt(r))
@@ -469,20 +460,37 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             }
         }
     }
-    let all = (1u32 << LANES) - 1;
-    for a in 0..D {
-        xn[a].scatter(ps.x.add(D * start + a), D, all);
-        sv[a].scatter(ps.v.add(D * start + a), D, all);
+    // Whole records, transposed in registers (`Lane::store_records`).
+    V::store_records(ps.x.add(D * start), D, &xn);
+    V::store_records(ps.v.add(D * start), D, &sv);
+    let mut flat = [zero; MAX_D * MAX_D];
+    for (c, e) in flat.iter_mut().enumerate().take(D * D) {
+        *e = V::load(&cs.affine[c]);
     }
-    for j in 0..D {
-        for i in 0..D {
-            let c = i + D * j;
-            V::load(&cs.affine[c]).scatter(ps.affine.add(D * D * start + c), D * D, all);
-            f[j][i].scatter(ps.f_e.add(D * D * start + c), D * D, all);
-            if let Some(fp) = &f_p_new {
-                fp[j][i].scatter(ps.f_p.add(D * D * start + c), D * D, all);
-            }
-        }
+    V::store_records(ps.affine.add(D * D * start), D * D, &flat[..D * D]);
+    store_mat(ps.f_e, start, &f);
+    if let Some(fp) = &f_p_new {
+        store_mat(ps.f_p, start, fp);
     }
     true
+}
+
+/// The inverse of [`gather_mat`]: writes `m` to the particle matrices at `p` (column-major),
+/// particles `start..start + LANES`.
+///
+/// # Safety
+/// The particles are in the array.
+#[inline(always)]
+unsafe fn store_mat<T: Real, V: Lane<Scalar = T>, const D: usize>(
+    p: *mut T,
+    start: usize,
+    m: &LMat<V, D>,
+) {
+    let mut e = [V::splat(T::ZERO); MAX_D * MAX_D];
+    for j in 0..D {
+        for i in 0..D {
+            e[i + D * j] = m[j][i];
+        }
+    }
+    V::store_records(p.add(D * D * start), D * D, &e[..D * D]);
 }
