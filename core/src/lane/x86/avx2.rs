@@ -63,7 +63,8 @@ pub(super) unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
 
 /// [`Lane::load_records`] on eight `f32` lanes: blocks of up to eight components, one
 /// (masked) load per record and an 8 × 8 transpose (blocks of three or four: 128-bit loads
-/// and two 4 × 4 transposes); a last one or two components are gathered.
+/// and two 4 × 4 transposes); a last two components as a pair ([`load_pairs8`]), a last one
+/// as a vector (`rec = 1`) or a gather.
 ///
 /// # Safety
 /// As [`Lane::load_records`]; AVX2 available.
@@ -102,9 +103,65 @@ pub(super) unsafe fn load_records8(base: *const f32, rec: usize, out: &mut [__m2
         }
         c0 += m;
     }
-    for (c, o) in out.iter_mut().enumerate().skip(c0) {
-        *o = F32x8::gather(base.add(c), rec).0;
+    // The last one or two components: two as a pair; one as a vector (one-component records)
+    // or a gather (on AMD Zen 4 one gather costs less than the pair loads and shuffles).
+    match out.len() - c0 {
+        0 => {}
+        2 => [out[c0], out[c0 + 1]] = load_pairs8(base.add(c0), rec),
+        _ if rec == 1 => out[0] = _mm256_loadu_ps(base),
+        _ => out[c0] = F32x8::gather(base.add(c0), rec).0,
     }
+}
+
+/// Components 0 and 1 of eight records of `rec` scalars at `p`, as two vectors (one 64-bit
+/// load per record, then a de-interleave by shuffles).
+///
+/// # Safety
+/// `p.add(rec·l)` is valid for reading two scalars, `l < 8`; AVX2 available.
+#[inline(always)]
+unsafe fn load_pairs8(p: *const f32, rec: usize) -> [__m256; 2] {
+    let q = |l: usize| p.add(rec * l).cast::<i64>().read_unaligned();
+    // [r0 r1 | r4 r5] and [r2 r3 | r6 r7] (each rᵢ = aᵢ bᵢ).
+    let x = _mm256_castsi256_ps(_mm256_set_epi64x(q(5), q(4), q(1), q(0)));
+    let y = _mm256_castsi256_ps(_mm256_set_epi64x(q(7), q(6), q(3), q(2)));
+    [
+        _mm256_shuffle_ps::<0x88>(x, y),
+        _mm256_shuffle_ps::<0xDD>(x, y),
+    ]
+}
+
+/// The inverse of [`load_pairs8`]: lane `l` of `a` and `b` to components 0 and 1 of record
+/// `l` at `p` (one 64-bit store per record).
+///
+/// # Safety
+/// `p.add(rec·l)` is valid for writing two scalars, `l < 8`; AVX2 available.
+#[inline(always)]
+unsafe fn store_pairs8(p: *mut f32, rec: usize, a: __m256, b: __m256) {
+    let mut lo = [0i64; 4];
+    let mut hi = [0i64; 4];
+    // [r0 r1 | r4 r5] and [r2 r3 | r6 r7].
+    _mm256_storeu_si256(
+        lo.as_mut_ptr().cast(),
+        _mm256_castps_si256(_mm256_unpacklo_ps(a, b)),
+    );
+    _mm256_storeu_si256(
+        hi.as_mut_ptr().cast(),
+        _mm256_castps_si256(_mm256_unpackhi_ps(a, b)),
+    );
+    // Volatile (a pair is 4-byte aligned, as its scalars): plain stores would be vectorised
+    // into two scatter instructions on AVX-512, which are slow on AMD Zen 4.
+    let w = |l: usize, v: i64| {
+        let pair = core::mem::transmute::<i64, [u32; 2]>(v);
+        core::ptr::write_volatile(p.add(rec * l).cast::<[u32; 2]>(), pair);
+    };
+    w(0, lo[0]);
+    w(1, lo[1]);
+    w(2, hi[0]);
+    w(3, hi[1]);
+    w(4, lo[2]);
+    w(5, lo[3]);
+    w(6, hi[2]);
+    w(7, hi[3]);
 }
 
 /// Writes lanes `0..m` of `x` to `p[0..m]` with plain stores of 4, 2 and 1 lanes (a masked
@@ -132,8 +189,8 @@ unsafe fn store_first(p: *mut f32, x: __m256, m: usize) {
 }
 
 /// [`Lane::store_records`] on eight `f32` lanes: the transposes of [`load_records8`] (each is
-/// its own inverse), plain stores of each record's block; a last one or two
-/// components are stored as scalars.
+/// its own inverse), plain stores of each record's block; a last two components as a pair
+/// ([`store_pairs8`]), a last one as a vector (`rec = 1`) or scalars.
 ///
 /// # Safety
 /// As [`Lane::store_records`]; AVX2 available.
@@ -160,12 +217,19 @@ pub(super) unsafe fn store_records8(base: *mut f32, rec: usize, vals: &[__m256])
         }
         c0 += m;
     }
-    for (c, v) in vals.iter().enumerate().skip(c0) {
-        let mut b = [0.0f32; 8];
-        _mm256_storeu_ps(b.as_mut_ptr(), *v);
-        for (i, x) in b.iter().enumerate() {
-            // Volatile: not merged into a scatter instruction.
-            core::ptr::write_volatile(base.add(i * rec + c), *x);
+    // The last one or two components: two as a pair; one as a vector (one-component records)
+    // or scalars.
+    match vals.len() - c0 {
+        0 => {}
+        2 => store_pairs8(base.add(c0), rec, vals[c0], vals[c0 + 1]),
+        _ if rec == 1 => _mm256_storeu_ps(base, vals[0]),
+        _ => {
+            let mut b = [0.0f32; 8];
+            _mm256_storeu_ps(b.as_mut_ptr(), vals[c0]);
+            for (i, x) in b.iter().enumerate() {
+                // Volatile: not merged into a scatter instruction.
+                core::ptr::write_volatile(base.add(i * rec + c0), *x);
+            }
         }
     }
 }
