@@ -460,14 +460,13 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             }
         }
     }
-    // Whole records, transposed in registers (`Lane::store_records`).
-    V::store_records(ps.x.add(D * start), D, &xn);
-    V::store_records(ps.v.add(D * start), D, &sv);
+    store_records::<T, V>(ps.x.add(D * start), D, &xn);
+    store_records::<T, V>(ps.v.add(D * start), D, &sv);
     let mut flat = [zero; MAX_D * MAX_D];
     for (c, e) in flat.iter_mut().enumerate().take(D * D) {
         *e = V::load(&cs.affine[c]);
     }
-    V::store_records(ps.affine.add(D * D * start), D * D, &flat[..D * D]);
+    store_records::<T, V>(ps.affine.add(D * D * start), D * D, &flat[..D * D]);
     store_mat(ps.f_e, start, &f);
     if let Some(fp) = &f_p_new {
         store_mat(ps.f_p, start, fp);
@@ -492,5 +491,24 @@ unsafe fn store_mat<T: Real, V: Lane<Scalar = T>, const D: usize>(
             e[i + D * j] = m[j][i];
         }
     }
-    V::store_records(p.add(D * D * start), D * D, &e[..D * D]);
+    store_records::<T, V>(p.add(D * D * start), D * D, &e[..D * D]);
+}
+
+/// Writes `vals[c]` lane `l` to `base[l·rec + c]`: in `f32` as whole records transposed in
+/// registers ([`Lane::store_records`]); in `f64` by one strided store per component, which
+/// measured faster there (the `f64` row types are lane pairs, whose record stores go through
+/// buffers).
+///
+/// # Safety
+/// Every such address is valid for writing.
+#[inline(always)]
+unsafe fn store_records<T: Real, V: Lane<Scalar = T>>(base: *mut T, rec: usize, vals: &[V]) {
+    if core::mem::size_of::<T>() == 4 {
+        V::store_records(base, rec, vals);
+    } else {
+        let all = (1u32 << LANES) - 1;
+        for (c, v) in vals.iter().enumerate() {
+            v.scatter(base.add(c), rec, all);
+        }
+    }
 }
