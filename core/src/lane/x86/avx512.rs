@@ -3,7 +3,7 @@
 #![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 
 use super::super::Lane;
-use super::avx2::{load_records8, store_records8};
+use super::records::{load_records8, store_records8};
 use core::arch::x86_64::*;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 

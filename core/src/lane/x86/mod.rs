@@ -145,6 +145,7 @@ macro_rules! kmask {
 
 mod avx2;
 mod avx512;
+mod records;
 
 pub(crate) use avx2::{F32x8, F64x4};
 pub(crate) use avx512::{F32x16, F64x8};
