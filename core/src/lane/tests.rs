@@ -209,3 +209,67 @@ fn partial_and_record_loads_and_stores() {
         }
     }
 }
+
+/// `quad_sums` on one lane type: every output lane is `(x₀ + x₁) + (x₂ + x₃)` of its group
+/// and vector, in that order (values where another order rounds differently), with signed
+/// zeros and infinities kept.
+fn quad_sum_bits<V: Lane<Scalar = f32>>() {
+    let mut seed = 0x9e37_79b9u32;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    // Magnitudes from 2⁻²⁰ to 2²⁰ and both signs, so that sums cancel and round.
+    let mut cases: std::vec::Vec<[f32; 32]> = (0..2000)
+        .map(|_| {
+            core::array::from_fn(|_| {
+                let r = next();
+                let m = 1.0 + (r >> 9) as f32 / (1u32 << 23) as f32;
+                let e = (r % 41) as i32 - 20;
+                let s = if r & 256 != 0 { -1.0 } else { 1.0 };
+                s * m * 2f32.powi(e)
+            })
+        })
+        .collect();
+    // (1e8 + 1) + (−1e8 + 1) is 0 in f32; ((1e8 + 1) − 1e8) + 1 is 1.
+    cases.push(core::array::from_fn(|l| [1e8, 1.0, -1e8, 1.0][l % 4]));
+    cases.push(core::array::from_fn(|l| [-0.0, -0.0, 0.0, -0.0][l % 4]));
+    cases.push(core::array::from_fn(|l| {
+        [f32::INFINITY, 1.0, 2.0, -0.0][l % 4]
+    }));
+    for c in cases.chunks(4).filter(|c| c.len() == 4) {
+        let v: [V; 4] = core::array::from_fn(|i| V::load(&c[i]));
+        let mut got = [0.0f32; 32];
+        V::quad_sums(v).store(&mut got);
+        for h in 0..V::LANES / 4 {
+            for (i, x) in c.iter().enumerate() {
+                let g = &x[4 * h..];
+                let want = (g[0] + g[1]) + (g[2] + g[3]);
+                assert_eq!(
+                    got[4 * h + i].to_bits(),
+                    want.to_bits(),
+                    "group {h} vector {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn quad_sums_pair_lanes_in_order() {
+    quad_sum_bits::<X2<X2<X2<f32>>>>();
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn avx2() {
+            quad_sum_bits::<super::F32x8>();
+            quad_sum_bits::<X2<super::F32x8>>();
+        }
+        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU has AVX2 and FMA.
+            unsafe { avx2() };
+        }
+    }
+}
