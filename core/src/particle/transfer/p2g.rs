@@ -136,6 +136,7 @@ where
         outs: [OutChannel::none(); MAX_CH],
         kinds: [0; MAX_CH],
         na: 0,
+        mass_momentum: false,
     };
     op.active();
     dispatch::<T, _>(isa, &mut op);
@@ -155,6 +156,8 @@ struct P2gOp<'a, T, const D: usize> {
     outs: [OutChannel<T, D>; MAX_CH],
     kinds: [usize; MAX_CH],
     na: usize,
+    /// The channels are mass, then momentum along every axis (kinds `0..=D`), nothing else.
+    mass_momentum: bool,
 }
 
 /// The momentum density at a stencil's offset 0, `q₀ = m v − (m C h) fx` (the particle's
@@ -319,6 +322,7 @@ where
             add(8, &v.thermal_energy);
             add(9, &v.conductivity);
         }
+        self.mass_momentum = self.na == D + 1 && (0..=D).all(|k| self.kinds[k] == k);
     }
 }
 

@@ -141,19 +141,7 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     /// form of the module docs.
     #[inline(always)]
     pub fn add<const K: usize>(&mut self, s: &[usize; D], st: &Stencil<T, D>, coef: &[Coef<R, D>]) {
-        debug_assert!((2..=MAX_D).contains(&D));
-        let lanes = ((1u32 << K) - 1) << s[0];
-        // The tile row of stencil row (o₁, o₂): `rt[o₂][o₁]` (o₂ = 0 only in 2D).
-        let mut rt = [[0usize; MAX_WIDTH]; MAX_WIDTH];
-        for (o2, row) in rt.iter_mut().enumerate().take(outer::<D, K>()) {
-            for (o1, t) in row.iter_mut().enumerate().take(K) {
-                *t = s[1] + o1;
-                if D == 3 {
-                    *t += (s[2] + o2) * (K + 1);
-                }
-                self.bits[*t] |= lanes;
-            }
-        }
+        let rt = self.mark_rows::<K>(s);
         // Channel by channel, with the terms it has chosen once.
         for (j, k) in coef.iter().enumerate() {
             let acc = &mut self.acc[j];
@@ -164,7 +152,44 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
                 (true, true) => add_channel::<T, R, D, K, true, true>(acc, &rt, st, k),
             }
         }
+    }
+
+    /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`,
+    /// and `B_a` when `B`), `coef[0..=D]`, with the terms known at compile time.
+    #[inline(always)]
+    pub fn add_mass_momentum<const K: usize, const B: bool>(
+        &mut self,
+        s: &[usize; D],
+        st: &Stencil<T, D>,
+        coef: &[Coef<R, D>; 4],
+    ) {
+        debug_assert!(coef[1..=D].iter().all(|k| k.has_e && k.has_b == B));
+        let rt = self.mark_rows::<K>(s);
+        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &coef[0]);
+        for a in 1..=D {
+            add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &coef[a]);
+        }
+    }
+
+    /// Marks the tile lanes of a stencil at lane offsets `s` (`K` nodes per axis) as written,
+    /// and returns the tile row of each stencil row (`o₁`, `o₂`): `rt[o₂][o₁]` (`o₂ = 0` only
+    /// in 2D).
+    #[inline(always)]
+    fn mark_rows<const K: usize>(&mut self, s: &[usize; D]) -> [[usize; MAX_WIDTH]; MAX_WIDTH] {
+        debug_assert!((2..=MAX_D).contains(&D));
+        let lanes = ((1u32 << K) - 1) << s[0];
+        let mut rt = [[0usize; MAX_WIDTH]; MAX_WIDTH];
+        for (o2, row) in rt.iter_mut().enumerate().take(outer::<D, K>()) {
+            for (o1, t) in row.iter_mut().enumerate().take(K) {
+                *t = s[1] + o1;
+                if D == 3 {
+                    *t += (s[2] + o2) * (K + 1);
+                }
+                self.bits[*t] |= lanes;
+            }
+        }
         self.used = true;
+        rt
     }
 }
 

@@ -108,32 +108,62 @@ where
         s0: usize,
         out: &mut [Coef<R, D>; MAX_CH],
     ) {
-        let sp = R::splat;
         // With the axis-0 node offsets o₀ of the lanes.
-        let (w, dw, o0) = axis0::<T, R, D, K>(r.s, s0);
-        let idt = self.args.impulse_dt;
+        let lanes = axis0::<T, R, D, K>(r.s, s0);
         for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
-            match kind {
-                0 => *c = Coef::only(w * sp(r.mass)),
-                k @ 1..=3 => {
-                    // w (q₀ + (mCh) o) + Δt_f f.
-                    let a = k - 1;
-                    let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
-                    if idt == T::ZERO {
-                        c.p = w * q;
-                        c.has_b = false;
-                    } else {
-                        set_grad(c, w, dw, &r.fm, a, idt);
-                        c.p = w.mul_add(q, c.p);
-                    }
-                    for b in 1..D {
-                        c.e[b] = w * sp(r.mch.cols[b][a]);
-                    }
-                    c.has_e = true;
+            self.channel_coef(r, lanes, kind, c);
+        }
+    }
+
+    /// [`Self::set_coef`] for the channel set mass, then momentum along every axis (the
+    /// usual collocated P2G), known at compile time: the lane vectors stay in registers.
+    #[inline(always)]
+    fn mass_momentum_coef<R: Lane<Scalar = T>, const K: usize>(
+        &self,
+        r: &Ready<'_, T, D>,
+        s0: usize,
+    ) -> [Coef<R, D>; 4] {
+        let lanes = axis0::<T, R, D, K>(r.s, s0);
+        let mut out = [Coef::only(R::splat(T::ZERO)); 4];
+        for (kind, c) in out.iter_mut().enumerate().take(D + 1) {
+            self.channel_coef(r, lanes, kind, c);
+        }
+        out
+    }
+
+    /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
+    /// force, `7..` heat) from the axis-0 lanes `(w, dw, o₀)` of [`axis0`], into `c` (fields
+    /// that the channel does not use are left as they are).
+    #[inline(always)]
+    fn channel_coef<R: Lane<Scalar = T>>(
+        &self,
+        r: &Ready<'_, T, D>,
+        (w, dw, o0): (R, R, R),
+        kind: usize,
+        c: &mut Coef<R, D>,
+    ) {
+        let sp = R::splat;
+        let idt = self.args.impulse_dt;
+        match kind {
+            0 => *c = Coef::only(w * sp(r.mass)),
+            k @ 1..=3 => {
+                // w (q₀ + (mCh) o) + Δt_f f.
+                let a = k - 1;
+                let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
+                if idt == T::ZERO {
+                    c.p = w * q;
+                    c.has_b = false;
+                } else {
+                    set_grad(c, w, dw, &r.fm, a, idt);
+                    c.p = w.mul_add(q, c.p);
                 }
-                k @ 4..=6 => set_grad(c, w, dw, &r.fm, k - 4, T::ONE),
-                k => *c = Coef::only(w * sp(r.heat[k - 7])),
+                for b in 1..D {
+                    c.e[b] = w * sp(r.mch.cols[b][a]);
+                }
+                c.has_e = true;
             }
+            k @ 4..=6 => set_grad(c, w, dw, &r.fm, k - 4, T::ONE),
+            k => *c = Coef::only(w * sp(r.heat[k - 7])),
         }
     }
 
@@ -162,8 +192,17 @@ where
             // An empty tile takes any stencil.
             self.flush::<R, K, N>(tile, run, oc);
         };
-        self.set_coef::<R, K>(r, s[0], coef);
-        tile.add::<K>(&s, r.s, &coef[..self.na]);
+        if self.mass_momentum {
+            let c = self.mass_momentum_coef::<R, K>(r, s[0]);
+            if self.args.impulse_dt == T::ZERO {
+                tile.add_mass_momentum::<K, false>(&s, r.s, &c);
+            } else {
+                tile.add_mass_momentum::<K, true>(&s, r.s, &c);
+            }
+        } else {
+            self.set_coef::<R, K>(r, s[0], coef);
+            tile.add::<K>(&s, r.s, &coef[..self.na]);
+        }
         run.idx[run.n] = i;
         run.tau[run.n] = tau_dev;
         run.n += 1;
