@@ -416,7 +416,7 @@ where
         for (a, c) in coef.iter_mut().enumerate() {
             set_grad(c, w, dw, m, a, T::ONE);
         }
-        tile.add::<K>(&sp, s, &coef);
+        tile.add_uniform::<K, false, true>(&sp, s, &coef);
         run[*nrun] = i;
         *nrun += 1;
     }

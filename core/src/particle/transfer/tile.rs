@@ -171,6 +171,22 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         }
     }
 
+    /// [`Self::add`] for `D` channels that all have the terms `E_a` when `E` and `B_a` when
+    /// `B` (the force differential's forces: `B` only), known at compile time.
+    #[inline(always)]
+    pub fn add_uniform<const K: usize, const E: bool, const B: bool>(
+        &mut self,
+        s: &[usize; D],
+        st: &Stencil<T, D>,
+        coef: &[Coef<R, D>; D],
+    ) {
+        debug_assert!(coef.iter().all(|k| k.has_e == E && k.has_b == B));
+        let rt = self.mark_rows::<K>(s);
+        for (acc, k) in self.acc.iter_mut().zip(coef) {
+            add_channel::<T, R, D, K, E, B>(acc, &rt, st, k);
+        }
+    }
+
     /// Marks the tile lanes of a stencil at lane offsets `s` (`K` nodes per axis) as written,
     /// and returns the tile row of each stencil row (`o₁`, `o₂`): `rt[o₂][o₁]` (`o₂ = 0` only
     /// in 2D).
