@@ -136,7 +136,7 @@ where
         outs: [OutChannel::none(); MAX_CH],
         kinds: [0; MAX_CH],
         na: 0,
-        mass_momentum: false,
+        fixed: None,
     };
     op.active();
     dispatch::<T, _>(isa, &mut op);
@@ -156,8 +156,10 @@ struct P2gOp<'a, T, const D: usize> {
     outs: [OutChannel<T, D>; MAX_CH],
     kinds: [usize; MAX_CH],
     na: usize,
-    /// The channels are mass, then momentum along every axis (kinds `0..=D`), nothing else.
-    mass_momentum: bool,
+    /// The channels are mass, then momentum along every axis (kinds `0..=D`), then
+    /// (`Some(true)`) the three heat channels (kinds `7..=9`) and nothing else: a channel set
+    /// that the tile add knows at compile time. `None`: another set.
+    fixed: Option<bool>,
 }
 
 /// The momentum density at a stencil's offset 0, `q₀ = m v − (m C h) fx` (the particle's
@@ -322,7 +324,12 @@ where
             add(8, &v.thermal_energy);
             add(9, &v.conductivity);
         }
-        self.mass_momentum = self.na == D + 1 && (0..=D).all(|k| self.kinds[k] == k);
+        let mm = self.na > D && (0..=D).all(|k| self.kinds[k] == k);
+        self.fixed = match self.na - D - 1 {
+            0 if mm => Some(false),
+            3 if mm && (0..3).all(|h| self.kinds[D + 1 + h] == 7 + h) => Some(true),
+            _ => None,
+        };
     }
 }
 

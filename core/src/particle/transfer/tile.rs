@@ -154,20 +154,26 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         }
     }
 
-    /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`,
-    /// and `B_a` when `B`), `coef[0..=D]`, with the terms known at compile time.
+    /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`, and
+    /// `B_a` when `B`), `coef.0[0..=D]`, then with `HEAT` the three heat channels (`P` only),
+    /// `coef.1`, with the terms known at compile time.
     #[inline(always)]
-    pub fn add_mass_momentum<const K: usize, const B: bool>(
+    pub fn add_fixed<const K: usize, const B: bool, const HEAT: bool>(
         &mut self,
         s: &[usize; D],
         st: &Stencil<T, D>,
-        coef: &[Coef<R, D>; 4],
+        (mm, heat): &([Coef<R, D>; 4], [Coef<R, D>; 3]),
     ) {
-        debug_assert!(coef[1..=D].iter().all(|k| k.has_e && k.has_b == B));
+        debug_assert!(mm[1..=D].iter().all(|k| k.has_e && k.has_b == B));
         let rt = self.mark_rows::<K>(s);
-        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &coef[0]);
+        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0]);
         for a in 1..=D {
-            add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &coef[a]);
+            add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &mm[a]);
+        }
+        if HEAT {
+            for (h, k) in heat.iter().enumerate() {
+                add_channel::<T, R, D, K, false, false>(&mut self.acc[D + 1 + h], &rt, st, k);
+            }
         }
     }
 

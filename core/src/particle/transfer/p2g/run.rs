@@ -18,8 +18,14 @@ use crate::particle::transfer::nodes::{
 };
 use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use crate::particle::transfer::BatchStatus;
-use crate::particle::Dilation;
+use crate::particle::{Dilation, Kernel};
 use core::mem::MaybeUninit;
+
+/// The particle loop's channel sets (its `SET` parameter): mass and momentum along every axis
+/// (kinds `0..=D`); those and the three heat channels; any other set (the per-channel form).
+const MASS_MOMENTUM: u8 = 1;
+const WITH_HEAT: u8 = 2;
+const ANY_CHANNELS: u8 = 0;
 
 /// Where a particle's pass is: its scalar pass, or its lane of the chunk's buffers (when that
 /// ran on lanes); and its position.
@@ -116,19 +122,26 @@ where
     }
 
     /// [`Self::set_coef`] for the channel set mass, then momentum along every axis (the
-    /// usual collocated P2G), known at compile time: the lane vectors stay in registers.
+    /// usual collocated P2G), then with `HEAT` the three heat channels, known at compile time:
+    /// the lane vectors stay in registers.
     #[inline(always)]
-    fn mass_momentum_coef<R: Lane<Scalar = T>, const K: usize>(
+    fn fixed_coef<R: Lane<Scalar = T>, const K: usize, const HEAT: bool>(
         &self,
         r: &Ready<'_, T, D>,
         s0: usize,
-    ) -> [Coef<R, D>; 4] {
+    ) -> ([Coef<R, D>; 4], [Coef<R, D>; 3]) {
         let lanes = axis0::<T, R, D, K>(r.s, s0);
-        let mut out = [Coef::only(R::splat(T::ZERO)); 4];
-        for (kind, c) in out.iter_mut().enumerate().take(D + 1) {
+        let z = Coef::only(R::splat(T::ZERO));
+        let (mut mm, mut heat) = ([z; 4], [z; 3]);
+        for (kind, c) in mm.iter_mut().enumerate().take(D + 1) {
             self.channel_coef(r, lanes, kind, c);
         }
-        out
+        if HEAT {
+            for (h, c) in heat.iter_mut().enumerate() {
+                self.channel_coef(r, lanes, 7 + h, c);
+            }
+        }
+        (mm, heat)
     }
 
     /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
@@ -171,7 +184,7 @@ where
     /// particle does not fit in its tile or the run is full.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize, const SET: u8>(
         &mut self,
         i: usize,
         r: &Ready<'_, T, D>,
@@ -192,16 +205,28 @@ where
             // An empty tile takes any stencil.
             self.flush::<R, K, N>(tile, run, oc);
         };
-        if self.mass_momentum {
-            let c = self.mass_momentum_coef::<R, K>(r, s[0]);
-            if self.args.impulse_dt == T::ZERO {
-                tile.add_mass_momentum::<K, false>(&s, r.s, &c);
-            } else {
-                tile.add_mass_momentum::<K, true>(&s, r.s, &c);
+        let idt = self.args.impulse_dt;
+        match SET {
+            MASS_MOMENTUM => {
+                let c = self.fixed_coef::<R, K, false>(r, s[0]);
+                if idt == T::ZERO {
+                    tile.add_fixed::<K, false, false>(&s, r.s, &c);
+                } else {
+                    tile.add_fixed::<K, true, false>(&s, r.s, &c);
+                }
             }
-        } else {
-            self.set_coef::<R, K>(r, s[0], coef);
-            tile.add::<K>(&s, r.s, &coef[..self.na]);
+            WITH_HEAT => {
+                let c = self.fixed_coef::<R, K, true>(r, s[0]);
+                if idt == T::ZERO {
+                    tile.add_fixed::<K, false, true>(&s, r.s, &c);
+                } else {
+                    tile.add_fixed::<K, true, true>(&s, r.s, &c);
+                }
+            }
+            _ => {
+                self.set_coef::<R, K>(r, s[0], coef);
+                tile.add::<K>(&s, r.s, &coef[..self.na]);
+            }
         }
         run.idx[run.n] = i;
         run.tau[run.n] = tau_dev;
@@ -250,7 +275,7 @@ where
     /// `x` its position; `lane_stencil` its stencil if the lanes made it.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize, const SET: u8>(
         &mut self,
         i: usize,
         (pre, from_lanes, x): Source<'_, T, D>,
@@ -278,7 +303,7 @@ where
         };
         let r = match ready {
             Err(e) => Err(e),
-            Ok(r) => self.tile_add::<R, K, N>(i, &r, tau_dev, tile, run, oc, coef),
+            Ok(r) => self.tile_add::<R, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
         };
         self.first.note(i, r);
     }
@@ -299,7 +324,16 @@ where
 
     #[inline(always)]
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        with_nodes!(self.args.kernel, D, |K, N| self.run_nodes::<V, R, K, N>())
+        // The usual channel sets get particle loops of their own for the quadratic kernel
+        // (the channel terms known at compile time); other sets, and the cubic kernel, run
+        // the per-channel form. Chosen once per call.
+        match (self.args.kernel, self.fixed) {
+            (Kernel::Quadratic, Some(heat)) if D == 2 => self.run_fixed::<V, R, 3, 9>(heat),
+            (Kernel::Quadratic, Some(heat)) => self.run_fixed::<V, R, 3, 27>(heat),
+            _ => with_nodes!(self.args.kernel, D, |K, N| {
+                self.run_nodes::<V, R, K, N, ANY_CHANNELS>()
+            }),
+        }
     }
 }
 
@@ -308,9 +342,29 @@ where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
+    /// The particle loop for a fixed channel set: mass and momentum, then with `heat` the
+    /// heat channels.
+    #[inline(always)]
+    fn run_fixed<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
+        &mut self,
+        heat: bool,
+    ) -> BatchStatus {
+        if heat {
+            self.run_nodes::<V, R, K, N, WITH_HEAT>()
+        } else {
+            self.run_nodes::<V, R, K, N, MASS_MOMENTUM>()
+        }
+    }
+
     /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
     #[inline(always)]
-    fn run_nodes<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    fn run_nodes<
+        V: Lane<Scalar = T>,
+        R: Lane<Scalar = T>,
+        const K: usize,
+        const N: usize,
+        const SET: u8,
+    >(
         &mut self,
     ) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
@@ -429,7 +483,7 @@ where
                     let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
-                        self.finish::<R, K, N>(
+                        self.finish::<R, K, N, SET>(
                             start + l,
                             (&pres[l], from_lanes, &xs[l]),
                             tau,
