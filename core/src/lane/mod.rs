@@ -208,25 +208,6 @@ pub trait Lane:
         Self::load(&a)
     }
 
-    /// Sums of four-lane groups of four vectors (`LANES` a multiple of 4, at most 32): lane
-    /// `4h + i` of the result is `(x₀ + x₁) + (x₂ + x₃)`, `x_k` lane `4h + k` of `v[i]`. By
-    /// default through memory; the eight-lane `f32` type uses two levels of horizontal adds,
-    /// which pair the same lanes in the same order (the same bits).
-    #[inline(always)]
-    #[must_use]
-    fn quad_sums(v: [Self; 4]) -> Self {
-        debug_assert!(Self::LANES % 4 == 0 && Self::LANES <= 32);
-        let (mut b, mut o) = ([Self::Scalar::ZERO; 32], [Self::Scalar::ZERO; 32]);
-        for (i, x) in v.iter().enumerate() {
-            x.store(&mut b);
-            for h in 0..Self::LANES / 4 {
-                let g = &b[4 * h..4 * h + 4];
-                o[4 * h + i] = (g[0] + g[1]) + (g[2] + g[3]);
-            }
-        }
-        Self::load(&o)
-    }
-
     /// `1/√self` for a positive normal `self`, to a few ulps. Vector paths: the Newton
     /// iteration [`lmat::rsqrt_newton`] (no division or square-root instruction, whose
     /// throughput would dominate the kernels); scalars: `1/√x` with the correctly rounded

@@ -20,8 +20,7 @@
 //! read into eight-lane vectors: component `a` in vector `a / 2`, lanes `4 (a mod 2) + o₀`, the
 //! other lanes 0. Each multiply-add of the contraction above then runs for two components'
 //! `K` axis-0 offsets at once, and the last level is one product per vector followed by sums of
-//! each component's four lanes, `(l₀ + l₁) + (l₂ + l₃)` ([`Lane::quad_sums`], four outputs at a
-//! time; lanes past `K` are 0). Every lane's operations, in order, are the same on every eight-lane row type, so
+//! `K` lanes. Every lane's operations, in order, are the same on every eight-lane row type, so
 //! AVX2 and AVX-512 give the same bits.
 
 use super::InChannel;
@@ -93,6 +92,7 @@ pub(crate) unsafe fn node_field_sums<
         g: Mat::ZERO,
         finite,
     };
+    let mut l = [[[T::ZERO; LANES]; 2]; 8];
     let mut f = [z; 8];
     // (acc index, factor) per output: g₀, g₁, g₂, then with FULL Σ w u, moments 0, 1, 2.
     let mut k = [0usize; 8];
@@ -115,32 +115,25 @@ pub(crate) unsafe fn node_field_sums<
             nq += 1;
         }
     }
-    // Four outputs at a time: the products' slot sums land in lanes `q mod 4` (component
-    // `2j`) and `4 + q mod 4` (component `2j + 1`); lanes `K..4` of a slot are 0 and add
-    // nothing.
-    let mut l = [T::ZERO; LANES];
-    for q0 in (0..nq).step_by(4) {
+    for q in 0..nq {
         for j in 0..pv {
-            let mut v = [z; 4];
-            for (i, x) in v.iter_mut().enumerate() {
-                if q0 + i < nq {
-                    *x = acc[k[q0 + i]][j] * f[q0 + i];
-                }
+            (acc[k[q]][j] * f[q]).store(&mut l[q][j]);
+        }
+    }
+    for q in 0..nq {
+        for a in 0..D {
+            if !on(a) {
+                continue;
             }
-            R::quad_sums(v).store(&mut l);
-            for i in 0..4.min(nq - q0) {
-                let q = q0 + i;
-                for a in 2 * j..(2 * j + 2).min(D) {
-                    if !on(a) {
-                        continue;
-                    }
-                    let sum = l[SLOT * (a % 2) + i];
-                    match q {
-                        _ if q < D => out.g.cols[q][a] = sum,
-                        _ if q == D => out.v[a] = sum,
-                        _ => out.mo.cols[q - D - 1][a] = sum,
-                    }
-                }
+            let lanes = &l[q][a / 2][SLOT * (a % 2)..];
+            let mut sum = lanes[0];
+            for x in &lanes[1..K] {
+                sum += *x;
+            }
+            match q {
+                _ if q < D => out.g.cols[q][a] = sum,
+                _ if q == D => out.v[a] = sum,
+                _ => out.mo.cols[q - D - 1][a] = sum,
             }
         }
     }
