@@ -155,14 +155,16 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     }
 
     /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`, and
-    /// `B_a` when `B`), `coef.0[0..=D]`, then with `HEAT` the three heat channels (`P` only),
-    /// `coef.1`, with the terms known at compile time.
+    /// `B_a` when `B`), `coef.0[0..=D]`, then with `heat` the three heat channels (`P` only),
+    /// `coef.1`; the terms are known at compile time (`heat` is a constant where it is
+    /// inlined).
     #[inline(always)]
-    pub fn add_fixed<const K: usize, const B: bool, const HEAT: bool>(
+    pub fn add_fixed<const K: usize, const B: bool>(
         &mut self,
         s: &[usize; D],
         st: &Stencil<T, D>,
-        (mm, heat): &([Coef<R, D>; 4], [Coef<R, D>; 3]),
+        (mm, hc): &([Coef<R, D>; 4], [Coef<R, D>; 3]),
+        heat: bool,
     ) {
         debug_assert!(mm[1..=D].iter().all(|k| k.has_e && k.has_b == B));
         let rt = self.mark_rows::<K>(s);
@@ -170,8 +172,8 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         for a in 1..=D {
             add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &mm[a]);
         }
-        if HEAT {
-            for (h, k) in heat.iter().enumerate() {
+        if heat {
+            for (h, k) in hc.iter().enumerate() {
                 add_channel::<T, R, D, K, false, false>(&mut self.acc[D + 1 + h], &rt, st, k);
             }
         }

@@ -122,26 +122,27 @@ where
     }
 
     /// [`Self::set_coef`] for the channel set mass, then momentum along every axis (the
-    /// usual collocated P2G), then with `HEAT` the three heat channels, known at compile time:
+    /// usual collocated P2G), then with `heat` the three heat channels, known at compile time:
     /// the lane vectors stay in registers.
     #[inline(always)]
-    fn fixed_coef<R: Lane<Scalar = T>, const K: usize, const HEAT: bool>(
+    fn fixed_coef<R: Lane<Scalar = T>, const K: usize>(
         &self,
         r: &Ready<'_, T, D>,
         s0: usize,
+        heat: bool,
     ) -> ([Coef<R, D>; 4], [Coef<R, D>; 3]) {
         let lanes = axis0::<T, R, D, K>(r.s, s0);
         let z = Coef::only(R::splat(T::ZERO));
-        let (mut mm, mut heat) = ([z; 4], [z; 3]);
+        let (mut mm, mut hc) = ([z; 4], [z; 3]);
         for (kind, c) in mm.iter_mut().enumerate().take(D + 1) {
             self.channel_coef(r, lanes, kind, c);
         }
-        if HEAT {
-            for (h, c) in heat.iter_mut().enumerate() {
+        if heat {
+            for (h, c) in hc.iter_mut().enumerate() {
                 self.channel_coef(r, lanes, 7 + h, c);
             }
         }
-        (mm, heat)
+        (mm, hc)
     }
 
     /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
@@ -206,26 +207,17 @@ where
             self.flush::<R, K, N>(tile, run, oc);
         };
         let idt = self.args.impulse_dt;
-        match SET {
-            MASS_MOMENTUM => {
-                let c = self.fixed_coef::<R, K, false>(r, s[0]);
-                if idt == T::ZERO {
-                    tile.add_fixed::<K, false, false>(&s, r.s, &c);
-                } else {
-                    tile.add_fixed::<K, true, false>(&s, r.s, &c);
-                }
-            }
-            WITH_HEAT => {
-                let c = self.fixed_coef::<R, K, true>(r, s[0]);
-                if idt == T::ZERO {
-                    tile.add_fixed::<K, false, true>(&s, r.s, &c);
-                } else {
-                    tile.add_fixed::<K, true, true>(&s, r.s, &c);
-                }
-            }
-            _ => {
-                self.set_coef::<R, K>(r, s[0], coef);
-                tile.add::<K>(&s, r.s, &coef[..self.na]);
+        if SET == ANY_CHANNELS {
+            self.set_coef::<R, K>(r, s[0], coef);
+            tile.add::<K>(&s, r.s, &coef[..self.na]);
+        } else {
+            // A constant in each loop (`SET`), so the heat terms fold away or stay.
+            let heat = SET == WITH_HEAT;
+            let c = self.fixed_coef::<R, K>(r, s[0], heat);
+            if idt == T::ZERO {
+                tile.add_fixed::<K, false>(&s, r.s, &c, heat);
+            } else {
+                tile.add_fixed::<K, true>(&s, r.s, &c, heat);
             }
         }
         run.idx[run.n] = i;
