@@ -279,12 +279,15 @@ where
 }
 
 /// With heat, G2P's batch equals calls of one particle, bit for bit and status for status: the
-/// batch updates a chunk on SIMD lanes after each particle's heat step (the scalar one, per
-/// lane), solids and liquids alike. Chunks of 8 (the grid warms every particle by about 3 K):
-/// solids below the melting point; liquids; solids at it filling their latent buffer; solids
-/// that melt in this step (projected at once); solids of which half melt (solids and liquids
-/// in one chunk); a NaN temperature; an invalid thermal state (a liquid below the melting
-/// point); liquids with general `F_P`; a partial chunk. With and without phase change.
+/// batch updates a chunk on SIMD lanes after each particle's heat step (on the lanes when every
+/// lane stays in its segment, else the scalar step per lane), solids and liquids alike.
+/// Chunks of 8 on a grid that warms every particle by about 3 K and on one that cools it by
+/// about 3 K: solids below the melting point; liquids; solids at it with a buffer within half
+/// of empty (emptying when cooled: some freeze on); solids at it with a nearly full buffer
+/// (melting when warmed); solids of which half melt (solids and liquids in one chunk); a NaN
+/// temperature; an invalid thermal state (a liquid below the melting point); liquids with
+/// general `F_P`, some within 3 K of the melting point (reaching it when cooled); a partial
+/// chunk. With and without phase change.
 fn g2p_heat_chunks_match_single<T: BatchReal, const D: usize>()
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -309,14 +312,20 @@ where
         }),
         ..thermal.clone()
     };
-    let mut g = g2p_grid::<T, D>(cells, 5);
-    let mut rg = Pcg64::seed_from_u64(6);
-    for k in 0..g.ch[HC].len() {
-        g.ch[HC][k] = T::from_f64(TM + 3.0 + rg.random_range(0.0..1.0));
-        g.ch[HC + 1][k] = T::from_f64(TM + rg.random_range(-0.5..0.5));
-    }
+    let grid = |warm: f64| {
+        let mut g = g2p_grid::<T, D>(cells, 5);
+        let mut rg = Pcg64::seed_from_u64(6);
+        for k in 0..g.ch[HC].len() {
+            g.ch[HC][k] = T::from_f64(TM + warm * (3.0 + rg.random_range(0.0..1.0)));
+            g.ch[HC + 1][k] = T::from_f64(TM + rg.random_range(-0.5..0.5));
+        }
+        g
+    };
+    let grids = [("warming", grid(1.0)), ("cooling", grid(-1.0))];
+    let mats = [("phase change", &thermal), ("no phase change", &no_change)];
     for isa in Isa::available() {
-        for (name, mat) in [("phase change", &thermal), ("no phase change", &no_change)] {
+        for ((name, mat), (gname, g)) in mats.iter().flat_map(|m| grids.iter().map(move |g| (m, g)))
+        {
             let mut rng = Pcg64::seed_from_u64(12);
             let mut ps = particles::<T, D>(&mut rng, 83, hf, cells, mat);
             let c = T::from_f64;
@@ -344,8 +353,8 @@ where
             }
             ps[5 * 8 + 3].temperature = c(f64::NAN);
             ps[6 * 8 + 5].temperature = c(TM - 1.0);
-            let label = format!("{name} {isa:?}");
-            let first = batch_matches_single(isa, mat, &args, &ps, &g, &label);
+            let label = format!("{name} {gname} {isa:?}");
+            let first = batch_matches_single(isa, mat, &args, &ps, g, &label);
             assert_eq!(first, Some((43, Error::NonFinite)), "{label}");
         }
     }

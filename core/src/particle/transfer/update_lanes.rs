@@ -9,7 +9,8 @@
 //! multiplications and additions, no fused multiply-add, the matrix products and determinants of
 //! [`crate::mat::Mat`], the power-of-two scalings and roots of [`root_det`]), so every lane gets
 //! the bits of the scalar update. With heat, the heat step (temperature, latent buffer, phase)
-//! is the scalar one ([`thermal::step`]) per lane. Every check of the scalar path is made on
+//! is made on the lanes when every lane stays in its segment of the latent-heat model, else by
+//! the scalar [`thermal::step`] per lane ([`heat`]). Every check of the scalar path is made on
 //! all lanes (the input particle as [`check_particle`] checks it, the new position,
 //! `det(I + Δt∇v) > 0`, the new `F_E` and `F_P` and their determinants, the position limit);
 //! if any lane fails one, needs the remedy for `det(I + Δt∇v) ≤ 0`, or lies where
@@ -21,12 +22,14 @@
 //! [`liquid_projection`]: crate::particle::deformation::liquid_projection
 //! [`root_det`]: crate::particle::deformation::root_det
 
+mod heat;
+
 use super::{rd, wr, Checked, Particles};
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
-use crate::particle::thermal::{self, ThermalState};
+use crate::particle::thermal::ThermalState;
 use crate::particle::update::G2pSample;
-use crate::particle::{Heat, Material, Phase};
+use crate::particle::{Material, Phase};
 use crate::scalar::Real;
 
 /// Particles per chunk: the eight lanes of the row types.
@@ -158,58 +161,6 @@ unsafe fn chunk_phases(
         checked.for_phase(*p).ok()?;
     }
     Some(out)
-}
-
-/// The heat step of the chunk at `start`, per lane as the scalar update makes it: the input
-/// phase (solid when `phase` is null) valid for the material (`checked`), a finite input
-/// temperature, then [`thermal::step`] and [`thermal::check_result`] of the new state, written
-/// to `out`. Returns whether every lane passed (else the caller updates the chunk particle by
-/// particle).
-///
-/// # Safety
-/// The temperature array (and with phase change the latent array) holds the chunk's
-/// particles; `phase` is null or holds them.
-#[inline(always)]
-unsafe fn heat_chunk<T: Real>(
-    material: &Material<T>,
-    checked: &Checked,
-    ps: &Particles<T>,
-    start: usize,
-    cs: &ChunkSamples<T>,
-    heat: &Heat<T>,
-    out: &mut [ThermalState<T>; LANES],
-) -> bool {
-    for (l, new) in out.iter_mut().enumerate() {
-        let i = start + l;
-        let phase = if ps.phase.is_null() {
-            Phase::Solid
-        } else {
-            match Phase::from_code(rd(ps.phase, i)) {
-                Ok(p) => p,
-                Err(_) => return false,
-            }
-        };
-        if checked.for_phase(phase).is_err() {
-            return false;
-        }
-        let st = ThermalState {
-            temperature: rd(ps.temperature, i),
-            latent: if heat.phase_change {
-                rd(ps.latent, i)
-            } else {
-                T::ZERO
-            },
-            phase,
-        };
-        if !st.temperature.is_finite() {
-            return false;
-        }
-        match thermal::step(material, heat, &st, cs.t_pic[l], cs.t_flip[l]) {
-            Ok((st, _)) if thermal::check_result(heat, &st).is_ok() => *new = st,
-            _ => return false,
-        }
-    }
-    true
 }
 
 /// `(det M)^{1/d}` per lane with the bits of [`root_det`] (column equilibration by powers of
@@ -365,7 +316,15 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             None => return false,
         },
         Some(heat) => {
-            if !heat_chunk(material, checked, ps, start, cs, heat, &mut heat_new) {
+            let chunk = heat::HeatChunk {
+                material,
+                checked,
+                ps,
+                start,
+                cs,
+                heat,
+            };
+            if !heat::step::<T, V>(&chunk, &mut heat_new) {
                 return false;
             }
             heat_new.map(|st| st.phase)
