@@ -61,6 +61,9 @@ pub trait Lane:
         + Not<Output = Self::Mask>;
     /// Number of lanes.
     const LANES: usize;
+    /// Whether [`Lane::quad_sums`] runs in registers (else through memory, and a caller
+    /// summing stored lanes itself in the same order is faster).
+    const QUAD_SUMS_IN_REGISTERS: bool = false;
 
     /// Every lane `x`.
     #[must_use]
@@ -208,6 +211,16 @@ pub trait Lane:
         Self::load(&a)
     }
 
+    /// Sums of four-lane groups of four vectors (`LANES` a multiple of 4, at most 32): lane
+    /// `4h + i` of the result is `(x₀ + x₁) + (x₂ + x₃)`, `x_k` lane `4h + k` of `v[i]`. By
+    /// default through memory ([`quad_sums_in_memory`]); the eight-lane `f32` type uses two
+    /// levels of horizontal adds, which pair the same lanes in the same order (the same bits).
+    #[inline(always)]
+    #[must_use]
+    fn quad_sums(v: [Self; 4]) -> Self {
+        quad_sums_in_memory(v)
+    }
+
     /// `1/√self` for a positive normal `self`, to a few ulps. Vector paths: the Newton
     /// iteration [`lmat::rsqrt_newton`] (no division or square-root instruction, whose
     /// throughput would dominate the kernels); scalars: `1/√x` with the correctly rounded
@@ -253,6 +266,23 @@ pub trait Lane:
 
 /// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
 /// (`libm`), so this is also what `no_std` targets run.
+
+/// [`Lane::quad_sums`] through memory: each vector stored, its groups summed as scalars.
+#[inline(always)]
+#[must_use]
+pub(crate) fn quad_sums_in_memory<V: Lane>(v: [V; 4]) -> V {
+    debug_assert!(V::LANES % 4 == 0 && V::LANES <= 32);
+    let (mut b, mut o) = ([V::Scalar::ZERO; 32], [V::Scalar::ZERO; 32]);
+    for (i, x) in v.iter().enumerate() {
+        x.store(&mut b);
+        for h in 0..V::LANES / 4 {
+            let g = &b[4 * h..4 * h + 4];
+            o[4 * h + i] = (g[0] + g[1]) + (g[2] + g[3]);
+        }
+    }
+    V::load(&o)
+}
+
 impl<T: Real> Lane for T {
     type Scalar = T;
     type Mask = bool;

@@ -168,7 +168,7 @@ fn cbrt_has_the_scalar_bits() {
             cbrt_bits::<super::F32x8>();
             cbrt_bits::<X2<super::F32x8>>();
         }
-        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+        if has_avx2() {
             // SAFETY: the CPU has AVX2 and FMA.
             unsafe { avx2() };
         }
@@ -193,19 +193,110 @@ fn partial_and_record_loads_and_stores() {
             all::<super::F64x8>();
             all::<X2<super::F64x8>>();
         }
-        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
+        if has_avx2() {
             // SAFETY: the CPU has AVX2 and FMA.
             unsafe { avx2() };
         }
-        if std::is_x86_feature_detected!("avx512f")
-            && std::is_x86_feature_detected!("avx512vl")
-            && std::is_x86_feature_detected!("avx512dq")
-            && std::is_x86_feature_detected!("avx512bw")
-            && std::is_x86_feature_detected!("avx2")
-            && std::is_x86_feature_detected!("fma")
-        {
+        if has_avx512() {
             // SAFETY: the CPU has AVX-512 F/VL/DQ/BW, AVX2 and FMA.
             unsafe { avx512() };
         }
     }
+}
+
+/// `quad_sums` on one lane type: every output lane is `(x₀ + x₁) + (x₂ + x₃)` of its group
+/// and vector, in that order (values where another order rounds differently), with signed
+/// zeros and infinities kept.
+fn quad_sum_bits<V: Lane>() {
+    let mut seed = 0x9e37_79b9u32;
+    let mut next = || {
+        seed ^= seed << 13;
+        seed ^= seed >> 17;
+        seed ^= seed << 5;
+        seed
+    };
+    // Magnitudes from 2⁻⁴⁰ to 2⁴⁰ and both signs, so that sums cancel and round (in f64 too:
+    // 24 random mantissa bits over 80 binades).
+    let mut cases: std::vec::Vec<[f64; 32]> = (0..2000)
+        .map(|_| {
+            core::array::from_fn(|_| {
+                let r = next();
+                let m = 1.0 + (r >> 9) as f64 / (1u32 << 23) as f64;
+                let e = (next() % 81) as i32 - 40;
+                let s = if r & 256 != 0 { -1.0 } else { 1.0 };
+                s * m * 2f64.powi(e)
+            })
+        })
+        .collect();
+    // (1e8 + 1) + (−1e8 + 1) is 0 in f32; ((1e8 + 1) − 1e8) + 1 is 1 (1e17 likewise in f64).
+    cases.push(core::array::from_fn(|l| [1e8, 1.0, -1e8, 1.0][l % 4]));
+    cases.push(core::array::from_fn(|l| [1e17, 1.0, -1e17, 1.0][l % 4]));
+    cases.push(core::array::from_fn(|l| [-0.0, -0.0, 0.0, -0.0][l % 4]));
+    cases.push(core::array::from_fn(|l| {
+        [f64::INFINITY, 1.0, 2.0, -0.0][l % 4]
+    }));
+    let c = V::Scalar::from_f64;
+    for cs in cases.chunks(4).filter(|cs| cs.len() == 4) {
+        let x: [[V::Scalar; 32]; 4] = core::array::from_fn(|i| cs[i].map(c));
+        let v: [V; 4] = core::array::from_fn(|i| V::load(&x[i]));
+        let mut got = [V::Scalar::ZERO; 32];
+        V::quad_sums(v).store(&mut got);
+        for h in 0..V::LANES / 4 {
+            for (i, xi) in x.iter().enumerate() {
+                let g = &xi[4 * h..];
+                let want = (g[0] + g[1]) + (g[2] + g[3]);
+                assert_eq!(
+                    got[4 * h + i].to_f64().to_bits(),
+                    want.to_f64().to_bits(),
+                    "group {h} vector {i}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn quad_sums_pair_lanes_in_order() {
+    quad_sum_bits::<X2<X2<X2<f32>>>>();
+    quad_sum_bits::<X2<X2<X2<f64>>>>();
+    quad_sum_bits::<X2<X2<f64>>>();
+    #[cfg(target_arch = "x86_64")]
+    {
+        #[target_feature(enable = "avx2,fma")]
+        unsafe fn avx2() {
+            quad_sum_bits::<super::F32x8>();
+            quad_sum_bits::<X2<super::F32x8>>();
+            quad_sum_bits::<super::F64x4>();
+            quad_sum_bits::<X2<super::F64x4>>();
+        }
+        #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
+        unsafe fn avx512() {
+            quad_sum_bits::<super::F64x8>();
+            quad_sum_bits::<super::F32x16>();
+        }
+        if has_avx2() {
+            // SAFETY: the CPU has AVX2 and FMA.
+            unsafe { avx2() };
+        }
+        if has_avx512() {
+            // SAFETY: the CPU has AVX-512 F/VL/DQ/BW, AVX2 and FMA.
+            unsafe { avx512() };
+        }
+    }
+}
+
+/// The CPU has AVX2 and FMA (the AVX2 lane types' features).
+#[cfg(target_arch = "x86_64")]
+fn has_avx2() -> bool {
+    std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma")
+}
+
+/// The CPU has AVX-512 F/VL/DQ/BW, AVX2 and FMA (the AVX-512 lane types' features).
+#[cfg(target_arch = "x86_64")]
+fn has_avx512() -> bool {
+    std::is_x86_feature_detected!("avx512f")
+        && std::is_x86_feature_detected!("avx512vl")
+        && std::is_x86_feature_detected!("avx512dq")
+        && std::is_x86_feature_detected!("avx512bw")
+        && has_avx2()
 }

@@ -236,6 +236,19 @@ impl Lane for F32x8 {
         // SAFETY: see the module docs.
         unsafe { F32x8(cbrt8(self.0)) }
     }
+    const QUAD_SUMS_IN_REGISTERS: bool = true;
+    #[inline(always)]
+    fn quad_sums(v: [Self; 4]) -> Self {
+        // `vhaddps` adds adjacent lane pairs within each 128-bit half: the first level gives
+        // `(x₀ + x₁, x₂ + x₃)` of `v[0]`, `v[1]` (then `v[2]`, `v[3]`) per half, the second
+        // adds those pairs, leaving `v[i]`'s group `h` in lane `4h + i`.
+        // SAFETY: see the module docs.
+        unsafe {
+            let p = _mm256_hadd_ps(v[0].0, v[1].0);
+            let q = _mm256_hadd_ps(v[2].0, v[3].0);
+            F32x8(_mm256_hadd_ps(p, q))
+        }
+    }
 }
 
 /// libm's `cbrtf` (FreeBSD `s_cbrtf.c`) on eight lanes, the same operations in the same

@@ -20,8 +20,14 @@
 //! read into eight-lane vectors: component `a` in vector `a / 2`, lanes `4 (a mod 2) + o₀`, the
 //! other lanes 0. Each multiply-add of the contraction above then runs for two components'
 //! `K` axis-0 offsets at once, and the last level is one product per vector followed by sums of
-//! `K` lanes. Every lane's operations, in order, are the same on every eight-lane row type, so
-//! AVX2 and AVX-512 give the same bits.
+//! each component's `K` lanes: in 3D in order, `((l₀ + l₁) + l₂) + l₃`; in 2D (one vector per
+//! output, both components) pairwise, `(l₀ + l₁) + (l₂ + l₃)` with the lanes past `K` 0: four
+//! outputs at a time in registers where [`Lane::quad_sums`] runs there (horizontal adds on the
+//! eight-lane `f32` type, which saved a tenth of 2D G2P), else from the stored lanes (the
+//! `f64` and scalar rows, where the regrouping in registers measured slower; in 3D, with two
+//! vectors per output, horizontal adds measured slower in the C library too). Every lane's
+//! operations, in order, are the same on every eight-lane row type and instruction set, so
+//! they give the same bits.
 
 use super::InChannel;
 use crate::lane::Lane;
@@ -45,6 +51,19 @@ pub(crate) struct Sums<T, const D: usize> {
     pub g: Mat<T, D>,
     /// Every value read is finite.
     pub finite: bool,
+}
+
+impl<T: Real, const D: usize> Sums<T, D> {
+    /// Sets component `a` of output `q`: `g` column `q` for `q < d`, then `Σ w u`, then the
+    /// moments.
+    #[inline(always)]
+    fn put(&mut self, q: usize, a: usize, sum: T) {
+        match q {
+            _ if q < D => self.g.cols[q][a] = sum,
+            _ if q == D => self.v[a] = sum,
+            _ => self.mo.cols[q - D - 1][a] = sum,
+        }
+    }
 }
 
 /// The [`Sums`] over the `N = K^d` nodes of stencil `s` (`K ≤ 4`, `d` 2 or 3) of the components
@@ -92,7 +111,6 @@ pub(crate) unsafe fn node_field_sums<
         g: Mat::ZERO,
         finite,
     };
-    let mut l = [[[T::ZERO; LANES]; 2]; 8];
     let mut f = [z; 8];
     // (acc index, factor) per output: g₀, g₁, g₂, then with FULL Σ w u, moments 0, 1, 2.
     let mut k = [0usize; 8];
@@ -115,25 +133,57 @@ pub(crate) unsafe fn node_field_sums<
             nq += 1;
         }
     }
-    for q in 0..nq {
-        for j in 0..pv {
-            (acc[k[q]][j] * f[q]).store(&mut l[q][j]);
+    if D == 2 && R::QUAD_SUMS_IN_REGISTERS {
+        // Four outputs at a time: the products' slot sums land in lanes `q mod 4` (component
+        // 0) and `4 + q mod 4` (component 1); lanes `K..4` of a slot are 0 and add nothing.
+        let mut l = [T::ZERO; LANES];
+        for q0 in (0..nq).step_by(4) {
+            let mut v = [z; 4];
+            for (i, x) in v.iter_mut().enumerate() {
+                if q0 + i < nq {
+                    *x = acc[k[q0 + i]][0] * f[q0 + i];
+                }
+            }
+            R::quad_sums(v).store(&mut l);
+            for i in 0..4.min(nq - q0) {
+                for a in 0..D {
+                    if on(a) {
+                        out.put(q0 + i, a, l[SLOT * a + i]);
+                    }
+                }
+            }
         }
-    }
-    for q in 0..nq {
-        for a in 0..D {
-            if !on(a) {
-                continue;
+    } else if D == 2 {
+        // The same sums from each output's stored product.
+        let mut l = [T::ZERO; LANES];
+        for q in 0..nq {
+            (acc[k[q]][0] * f[q]).store(&mut l);
+            for a in 0..D {
+                if on(a) {
+                    let g = &l[SLOT * a..];
+                    out.put(q, a, (g[0] + g[1]) + (g[2] + g[3]));
+                }
             }
-            let lanes = &l[q][a / 2][SLOT * (a % 2)..];
-            let mut sum = lanes[0];
-            for x in &lanes[1..K] {
-                sum += *x;
+        }
+    } else {
+        // Each output's product stored, then its `K` lanes summed in order.
+        let mut l = [[[T::ZERO; LANES]; 2]; 8];
+        for q in 0..nq {
+            for j in 0..pv {
+                (acc[k[q]][j] * f[q]).store(&mut l[q][j]);
             }
-            match q {
-                _ if q < D => out.g.cols[q][a] = sum,
-                _ if q == D => out.v[a] = sum,
-                _ => out.mo.cols[q - D - 1][a] = sum,
+        }
+        for q in 0..nq {
+            for a in 0..D {
+                if !on(a) {
+                    continue;
+                }
+                let lanes = &l[q][a / 2][SLOT * (a % 2)..];
+                let mut sum = lanes[0];
+                for x in &lanes[1..K] {
+                    sum += *x;
+                }
+                out.put(q, a, sum);
             }
         }
     }
