@@ -211,6 +211,20 @@ pub trait Lane:
         Self::load(&a)
     }
 
+    /// Lanes `0..LANES/2` repeated in lanes `LANES/2..LANES` (at most 32 lanes). By default
+    /// through memory; lane pairs repeat their low half, the eight-lane `f32` type permutes.
+    #[inline(always)]
+    #[must_use]
+    fn dup_low_half(self) -> Self {
+        let mut b = [Self::Scalar::ZERO; 32];
+        self.store(&mut b);
+        let h = Self::LANES / 2;
+        for i in 0..h {
+            b[h + i] = b[i];
+        }
+        Self::load(&b)
+    }
+
     /// Sums of four-lane groups of four vectors (`LANES` a multiple of 4, at most 32): lane
     /// `4h + i` of the result is `(x₀ + x₁) + (x₂ + x₃)`, `x_k` lane `4h + k` of `v[i]`. By
     /// default through memory ([`quad_sums_in_memory`]); the eight-lane `f32` type uses two

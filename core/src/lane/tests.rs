@@ -104,10 +104,25 @@ fn records<V: Lane>() {
     }
 }
 
+/// `dup_low_half` repeats lanes `0..LANES/2` in the high half, signed zeros and NaN kept.
+fn dup_low<V: Lane>() {
+    let mut src: [V::Scalar; 32] = core::array::from_fn(|i| V::Scalar::from_i32(i as i32 + 1));
+    src[0] = -V::Scalar::ZERO;
+    src[1] = V::Scalar::from_f64(f64::NAN);
+    let mut got = [V::Scalar::from_i32(-7); 32];
+    V::load(&src).dup_low_half().store(&mut got);
+    let h = V::LANES / 2;
+    for (i, x) in got[..V::LANES].iter().enumerate() {
+        let want = if V::LANES == 1 { src[0] } else { src[i % h] };
+        assert_eq!(x.to_f64().to_bits(), want.to_f64().to_bits(), "lane {i}");
+    }
+}
+
 /// Every test above on lane type `V`.
 fn all<V: Lane>() {
     partial::<V>();
     records::<V>();
+    dup_low::<V>();
 }
 
 use crate::scalar::Real;

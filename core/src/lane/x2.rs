@@ -139,6 +139,10 @@ impl<V: Lane> Lane for X2<V> {
         X2([self.0[0].cbrt(), self.0[1].cbrt()])
     }
     #[inline(always)]
+    fn dup_low_half(self) -> Self {
+        X2([self.0[0], self.0[0]])
+    }
+    #[inline(always)]
     unsafe fn load_n(p: *const Self::Scalar, n: usize) -> Self {
         if n > V::LANES {
             X2([

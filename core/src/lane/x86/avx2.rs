@@ -238,6 +238,11 @@ impl Lane for F32x8 {
     }
     const QUAD_SUMS_IN_REGISTERS: bool = true;
     #[inline(always)]
+    fn dup_low_half(self) -> Self {
+        // SAFETY: see the module docs. Selector 0 for both halves: the low 128 bits.
+        unsafe { F32x8(_mm256_permute2f128_ps::<0x00>(self.0, self.0)) }
+    }
+    #[inline(always)]
     fn quad_sums(v: [Self; 4]) -> Self {
         // `vhaddps` adds adjacent lane pairs within each 128-bit half: the first level gives
         // `(x₀ + x₁, x₂ + x₃)` of `v[0]`, `v[1]` (then `v[2]`, `v[3]`) per half, the second

@@ -392,7 +392,8 @@ unsafe fn pair_row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>
     let (ra, rb) = (pa.offset(oa), pb.offset(ob));
     let low = (1u32 << K) - 1;
     if contiguous {
-        let va = R::load_mask(ra, low) + R::load_mask(ra.wrapping_sub(SLOT), low << SLOT);
+        // One masked load per channel; `a`'s row repeated in the high half in registers.
+        let va = R::load_mask(ra, low).dup_low_half();
         let vb = R::load_mask(rb.wrapping_sub(SLOT), low << SLOT);
         return (va, vb);
     }
