@@ -227,7 +227,7 @@ pub trait Lane:
 
     /// Sums of four-lane groups of four vectors (`LANES` a multiple of 4, at most 32): lane
     /// `4h + i` of the result is `(x₀ + x₁) + (x₂ + x₃)`, `x_k` lane `4h + k` of `v[i]`. By
-    /// default through memory ([`quad_sums_in_memory`]); the eight-lane `f32` type uses two
+    /// default through memory (`quad_sums_in_memory`); the eight-lane `f32` type uses two
     /// levels of horizontal adds, which pair the same lanes in the same order (the same bits).
     #[inline(always)]
     #[must_use]

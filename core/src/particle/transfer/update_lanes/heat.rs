@@ -11,7 +11,7 @@
 //!
 //! [`update_particle`]: crate::particle::update::update_particle
 
-use super::{rd, Checked, ChunkSamples, Particles, LANES};
+use super::{chunk_phases, rd, Checked, ChunkSamples, Particles, LANES};
 use crate::lane::Lane;
 use crate::particle::thermal::{self, ThermalState};
 use crate::particle::{Heat, Material, Phase};
@@ -42,11 +42,15 @@ pub(super) unsafe fn step<T: Real, V: Lane<Scalar = T>>(
     c: &HeatChunk<'_, T>,
     out: &mut [ThermalState<T>; LANES],
 ) -> bool {
-    on_lanes::<T, V>(c, out) || per_lane(c, out)
+    // The input phases, each valid for the material (as the scalar update checks them).
+    let Some(phases) = chunk_phases(c.ps.phase, c.start, c.checked) else {
+        return false;
+    };
+    on_lanes::<T, V>(c, &phases, out) || per_lane(c, &phases, out)
 }
 
-/// The heat step of the chunk at `start` on lanes, written to `out`, if every lane's input
-/// phase code is valid and its phase valid for the material (`checked`), its input state is
+/// The heat step of the chunk at `start` on lanes from the input `phases` (valid codes, each
+/// valid for the material: [`chunk_phases`]), written to `out`, if every lane's input state is
 /// finite and in one segment of [`thermal`]'s invariants, and its step stays in that segment
 /// with a result that [`thermal::check_result`] accepts. Returns whether it did (else nothing
 /// is written).
@@ -67,30 +71,21 @@ pub(super) unsafe fn step<T: Real, V: Lane<Scalar = T>>(
 #[inline(always)]
 unsafe fn on_lanes<T: Real, V: Lane<Scalar = T>>(
     c: &HeatChunk<'_, T>,
+    phases: &[Phase; LANES],
     out: &mut [ThermalState<T>; LANES],
 ) -> bool {
     let HeatChunk {
         material,
-        checked,
         ps,
         start,
         cs,
         heat,
+        ..
     } = *c;
-    let mut phases = [Phase::Solid; LANES];
     let mut liquid_flags = [T::ZERO; LANES];
-    if !ps.phase.is_null() {
-        for (l, (p, fl)) in phases.iter_mut().zip(liquid_flags.iter_mut()).enumerate() {
-            match Phase::from_code(rd(ps.phase, start + l)) {
-                Ok(Phase::Liquid) => (*p, *fl) = (Phase::Liquid, T::ONE),
-                Ok(Phase::Solid) => {}
-                Err(_) => return false,
-            }
-        }
-    }
-    for p in &phases {
-        if checked.for_phase(*p).is_err() {
-            return false;
+    for (fl, p) in liquid_flags.iter_mut().zip(phases) {
+        if *p == Phase::Liquid {
+            *fl = T::ONE;
         }
     }
     let zero = V::splat(T::ZERO);
@@ -152,37 +147,29 @@ unsafe fn on_lanes<T: Real, V: Lane<Scalar = T>>(
     true
 }
 
-/// The heat step of the chunk at `start`, per lane as the scalar update makes it: the input
-/// phase (solid when `phase` is null) valid for the material (`checked`), a finite input
-/// temperature, then [`thermal::step`] and [`thermal::check_result`] of the new state, written
+/// The heat step of the chunk at `start`, per lane as the scalar update makes it, from the
+/// input `phases` ([`chunk_phases`]): a finite input temperature, then [`thermal::step`] and [`thermal::check_result`] of the new state, written
 /// to `out`. Returns whether every lane passed.
 ///
 /// # Safety
 /// The temperature array (and with phase change the latent array) holds the chunk's
 /// particles; `phase` is null or holds them.
 #[inline(always)]
-unsafe fn per_lane<T: Real>(c: &HeatChunk<'_, T>, out: &mut [ThermalState<T>; LANES]) -> bool {
+unsafe fn per_lane<T: Real>(
+    c: &HeatChunk<'_, T>,
+    phases: &[Phase; LANES],
+    out: &mut [ThermalState<T>; LANES],
+) -> bool {
     let HeatChunk {
         material,
-        checked,
         ps,
         start,
         cs,
         heat,
+        ..
     } = *c;
-    for (l, new) in out.iter_mut().enumerate() {
+    for (l, (new, &phase)) in out.iter_mut().zip(phases).enumerate() {
         let i = start + l;
-        let phase = if ps.phase.is_null() {
-            Phase::Solid
-        } else {
-            match Phase::from_code(rd(ps.phase, i)) {
-                Ok(p) => p,
-                Err(_) => return false,
-            }
-        };
-        if checked.for_phase(phase).is_err() {
-            return false;
-        }
         let st = ThermalState {
             temperature: rd(ps.temperature, i),
             latent: if heat.phase_change {
@@ -359,7 +346,13 @@ mod tests {
                 cs: &cs,
                 heat: &heat,
             };
-            let (ok_l, ok_s) = unsafe { (on_lanes::<T, V>(&c, &mut a), per_lane(&c, &mut b)) };
+            // SAFETY: the arrays hold the chunk's particles.
+            let (ok_l, ok_s) = unsafe {
+                match chunk_phases(c.ps.phase, 0, &checked) {
+                    Some(ph) => (on_lanes::<T, V>(&c, &ph, &mut a), per_lane(&c, &ph, &mut b)),
+                    None => (step::<T, V>(&c, &mut a), false),
+                }
+            };
             if ok_l {
                 assert!(
                     ok_s,
