@@ -64,6 +64,9 @@ pub trait Lane:
     /// Whether [`Lane::quad_sums`] runs in registers (else through memory, and a caller
     /// summing stored lanes itself in the same order is faster).
     const QUAD_SUMS_IN_REGISTERS: bool = false;
+    /// Whether [`Lane::transpose8`] runs in registers (else through memory, and a caller
+    /// that can work on the vectors' stored lanes instead is faster).
+    const TRANSPOSE8_IN_REGISTERS: bool = false;
 
     /// Every lane `x`.
     #[must_use]
@@ -233,6 +236,28 @@ pub trait Lane:
     #[must_use]
     fn quad_sums(v: [Self; 4]) -> Self {
         quad_sums_in_memory(v)
+    }
+
+    /// The transpose of the 8 × 8 matrix whose rows are `v` (`LANES = 8`): lane `l` of result
+    /// `i` is lane `i` of `v[l]`, bits unchanged. By default through memory; the eight-lane
+    /// `f32` type shuffles in registers (unpacks, shuffles and 128-bit permutes).
+    #[inline(always)]
+    #[must_use]
+    fn transpose8(v: [Self; 8]) -> [Self; 8] {
+        debug_assert!(Self::LANES == 8);
+        let mut b = [[Self::Scalar::ZERO; 8]; 8];
+        for (r, x) in b.iter_mut().zip(&v) {
+            x.store(r);
+        }
+        let mut out = v;
+        for (i, o) in out.iter_mut().enumerate() {
+            let mut col = [Self::Scalar::ZERO; 8];
+            for (c, r) in col.iter_mut().zip(&b) {
+                *c = r[i];
+            }
+            *o = Self::load(&col);
+        }
+        out
     }
 
     /// `1/√self` for a positive normal `self`, to a few ulps. Vector paths: the Newton

@@ -118,11 +118,37 @@ fn dup_low<V: Lane>() {
     }
 }
 
+/// `transpose8` on an eight-lane type: lane `l` of result `i` is lane `i` of input `l`, with
+/// signed zeros, infinities and NaN kept.
+fn transpose<V: Lane>() {
+    let mut src: [[V::Scalar; 32]; 8] = core::array::from_fn(|l| {
+        core::array::from_fn(|i| V::Scalar::from_i32(8 * l as i32 + i as i32 + 1))
+    });
+    src[0][1] = -V::Scalar::ZERO;
+    src[3][5] = V::Scalar::from_f64(f64::NAN);
+    src[7][2] = V::Scalar::from_f64(f64::NEG_INFINITY);
+    let t = V::transpose8(core::array::from_fn(|l| V::load(&src[l])));
+    for (i, ti) in t.iter().enumerate() {
+        let mut got = [V::Scalar::ZERO; 32];
+        ti.store(&mut got);
+        for (l, x) in got[..8].iter().enumerate() {
+            assert_eq!(
+                x.to_f64().to_bits(),
+                src[l][i].to_f64().to_bits(),
+                "lane {l} of {i}"
+            );
+        }
+    }
+}
+
 /// Every test above on lane type `V`.
 fn all<V: Lane>() {
     partial::<V>();
     records::<V>();
     dup_low::<V>();
+    if V::LANES == 8 {
+        transpose::<V>();
+    }
 }
 
 use crate::scalar::Real;
@@ -193,6 +219,7 @@ fn cbrt_has_the_scalar_bits() {
 #[test]
 fn partial_and_record_loads_and_stores() {
     all::<f32>();
+    all::<X2<X2<X2<f32>>>>();
     all::<X2<X2<X2<f64>>>>();
     #[cfg(target_arch = "x86_64")]
     {
@@ -200,6 +227,7 @@ fn partial_and_record_loads_and_stores() {
         unsafe fn avx2() {
             all::<super::F32x8>();
             all::<super::F64x4>();
+            all::<X2<super::F64x4>>();
             all::<X2<super::F32x8>>();
         }
         #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]

@@ -3,7 +3,7 @@
 #![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 
 use super::super::Lane;
-use super::records::{load_records8, store_records8};
+use super::records::{load_records8, store_records8, transpose8};
 use core::arch::x86_64::*;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
@@ -237,6 +237,25 @@ impl Lane for F32x8 {
         unsafe { F32x8(cbrt8(self.0)) }
     }
     const QUAD_SUMS_IN_REGISTERS: bool = true;
+    const TRANSPOSE8_IN_REGISTERS: bool = true;
+    #[inline(always)]
+    fn transpose8(v: [Self; 8]) -> [Self; 8] {
+        let r = [
+            v[0].0, v[1].0, v[2].0, v[3].0, v[4].0, v[5].0, v[6].0, v[7].0,
+        ];
+        // SAFETY: see the module docs.
+        let t = unsafe { transpose8(r) };
+        [
+            F32x8(t[0]),
+            F32x8(t[1]),
+            F32x8(t[2]),
+            F32x8(t[3]),
+            F32x8(t[4]),
+            F32x8(t[5]),
+            F32x8(t[6]),
+            F32x8(t[7]),
+        ]
+    }
     #[inline(always)]
     fn dup_low_half(self) -> Self {
         // SAFETY: see the module docs. Selector 0 for both halves: the low 128 bits.

@@ -11,7 +11,7 @@ use core::arch::x86_64::*;
 /// The transpose of the 8 × 8 matrix whose rows are `r` (the usual unpack, shuffle,
 /// 128-bit permute sequence: 24 shuffles).
 #[inline(always)]
-unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
+pub(super) unsafe fn transpose8(r: [__m256; 8]) -> [__m256; 8] {
     let t0 = _mm256_unpacklo_ps(r[0], r[1]);
     let t1 = _mm256_unpackhi_ps(r[0], r[1]);
     let t2 = _mm256_unpacklo_ps(r[2], r[3]);

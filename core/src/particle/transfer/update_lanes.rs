@@ -41,11 +41,16 @@ const MAX_D: usize = 3;
 /// (vectors by component, matrices column-major, `c = i + d·j`).
 #[derive(Clone, Copy)]
 pub(super) struct ChunkSamples<T> {
-    v: [[T; LANES]; MAX_D],
-    affine: [[T; LANES]; MAX_D * MAX_D],
-    grad_v: [[T; LANES]; MAX_D * MAX_D],
-    t_pic: [T; LANES],
-    t_flip: [T; LANES],
+    /// `v_p` by component.
+    pub(super) v: [[T; LANES]; MAX_D],
+    /// `C_p`, column-major.
+    pub(super) affine: [[T; LANES]; MAX_D * MAX_D],
+    /// `∇v_p`, column-major.
+    pub(super) grad_v: [[T; LANES]; MAX_D * MAX_D],
+    /// `T_pic`.
+    pub(super) t_pic: [T; LANES],
+    /// `ΔT_flip`.
+    pub(super) t_flip: [T; LANES],
 }
 
 impl<T: Real> ChunkSamples<T> {
@@ -75,6 +80,28 @@ impl<T: Real> ChunkSamples<T> {
         }
         self.t_pic[l] = s.t_pic;
         self.t_flip[l] = s.t_flip;
+    }
+
+    /// Lane `l` (the inverse of [`ChunkSamples::set`]).
+    #[inline(always)]
+    pub(super) fn get<const D: usize>(&self, l: usize) -> G2pSample<T, D> {
+        let mut s = G2pSample {
+            v: [T::ZERO; D],
+            affine: crate::mat::Mat::ZERO,
+            grad_v: crate::mat::Mat::ZERO,
+            t_pic: self.t_pic[l],
+            t_flip: self.t_flip[l],
+        };
+        for a in 0..D {
+            s.v[a] = self.v[a][l];
+        }
+        for j in 0..D {
+            for i in 0..D {
+                s.affine.cols[j][i] = self.affine[i + D * j][l];
+                s.grad_v.cols[j][i] = self.grad_v[i + D * j][l];
+            }
+        }
+        s
     }
 }
 
