@@ -76,8 +76,9 @@ pub(crate) const MAX_OUT: usize = 7;
 /// [`chunk_sums`]: `p[q][j]` is vector `j` of output `q` (the gradient's columns `0..d`, then
 /// `Σ w u` and the moments `0..d`, the order of [`Sums::put`]), each component's `K` terms in
 /// its lanes as in the module docs, the other lanes `+0`; and whether every value read is
-/// finite. The same contraction and factors as [`node_field_sums`] (the same bits); kept apart
-/// from it because sharing its output table measured 20% slower 2D `f32` G2P and apply.
+/// finite. The same contraction and factors as [`node_field_sums`] ([`contract_rows`], the same
+/// bits); its output table is kept apart because sharing it measured 20% slower 2D `f32` G2P
+/// and apply.
 ///
 /// # Safety
 /// As [`node_field_sums`].
@@ -93,19 +94,7 @@ pub(crate) unsafe fn node_field_products<
     ch: &[InChannel<T, D>; D],
 ) -> ([[R; 2]; MAX_OUT], bool) {
     debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
-    let (w, dw) = (&s.w, &s.dw);
-    let mut same = true;
-    for c in ch {
-        same &= c.stride == ch[0].stride && c.stride[0] == 1;
-    }
-    let (acc, finite) = if same {
-        contract::<T, R, D, K, true, true>(ch, rel, s, (0, D))
-    } else {
-        contract::<T, R, D, K, false, true>(ch, rel, s, (0, D))
-    };
-    let f_w = in_slots::<T, R, K>(|o0| w[0][o0]);
-    let f_dw = in_slots::<T, R, K>(|o0| dw[0][o0]);
-    let f_wo = in_slots::<T, R, K>(|o0| w[0][o0] * T::from_i32(o0 as i32));
+    let (acc, finite, [f_w, f_dw, f_wo]) = contract_rows::<T, R, D, K, true>(ch, rel, s, (0, D));
     let mut p = [[R::splat(T::ZERO); 2]; MAX_OUT];
     for j in 0..D.div_ceil(2) {
         for b in 0..D {
@@ -141,24 +130,9 @@ pub(crate) unsafe fn node_field_sums<
 ) -> Sums<T, D> {
     debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
     let z = R::splat(T::ZERO);
-    let (w, dw) = (&s.w, &s.dw);
     let pv = D.div_ceil(2);
-    // Separate node arrays of one box (the usual layout) share their strides: one row offset
-    // for every component, and whole-row loads.
     let on = |a: usize| comps.0 <= a && a < comps.1;
-    let mut same = true;
-    for (a, c) in ch.iter().enumerate() {
-        same &= !on(a) || (c.stride == ch[comps.0].stride && c.stride[0] == 1);
-    }
-    let (acc, finite) = if same {
-        contract::<T, R, D, K, true, FULL>(ch, rel, s, comps)
-    } else {
-        contract::<T, R, D, K, false, FULL>(ch, rel, s, comps)
-    };
-    // Axis 0: the factors in the lanes of their offsets.
-    let f_w = in_slots::<T, R, K>(|o0| w[0][o0]);
-    let f_dw = in_slots::<T, R, K>(|o0| dw[0][o0]);
-    let f_wo = in_slots::<T, R, K>(|o0| w[0][o0] * T::from_i32(o0 as i32));
+    let (acc, finite, [f_w, f_dw, f_wo]) = contract_rows::<T, R, D, K, FULL>(ch, rel, s, comps);
     let mut out = Sums {
         v: [T::ZERO; D],
         mo: Mat::ZERO,
@@ -259,6 +233,43 @@ pub(crate) fn chunk_sums<R: Lane, const K: usize>(v: [R; LANES]) -> [R; 2] {
         }
     }
     out
+}
+
+/// [`contract`] of the components `comps` with its layout chosen (separate node arrays of one
+/// box, the usual layout, share their strides: one row offset for every component, and
+/// whole-row loads), and the axis-0 factors `[w, w′, w·o₀]` in the lanes of their offsets:
+/// the part shared by [`node_field_sums`] and [`node_field_products`].
+///
+/// # Safety
+/// As [`node_field_sums`].
+#[inline(always)]
+unsafe fn contract_rows<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const FULL: bool,
+>(
+    ch: &[InChannel<T, D>; D],
+    rel: &[isize; D],
+    s: &Stencil<T, D>,
+    comps: (usize, usize),
+) -> ([[R; 2]; 5], bool, [R; 3]) {
+    let mut same = true;
+    for (a, c) in ch.iter().enumerate() {
+        let on = comps.0 <= a && a < comps.1;
+        same &= !on || (c.stride == ch[comps.0].stride && c.stride[0] == 1);
+    }
+    let (acc, finite) = if same {
+        contract::<T, R, D, K, true, FULL>(ch, rel, s, comps)
+    } else {
+        contract::<T, R, D, K, false, FULL>(ch, rel, s, comps)
+    };
+    let (w, dw) = (&s.w, &s.dw);
+    let f_w = in_slots::<T, R, K>(|o0| w[0][o0]);
+    let f_dw = in_slots::<T, R, K>(|o0| dw[0][o0]);
+    let f_wo = in_slots::<T, R, K>(|o0| w[0][o0] * T::from_i32(o0 as i32));
+    (acc, finite, [f_w, f_dw, f_wo])
 }
 
 /// The sums `A_k` of the module docs as packed vectors (`acc[k][j]`, vector `j`; `A₃`, `A₄`
