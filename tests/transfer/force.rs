@@ -306,8 +306,9 @@ fn apply_run_that_overflows_is_added_one_by_one() {
     }
 }
 
-/// `apply` over many particles (full chunks of lanes and a partial one, on every instruction
-/// set) against the reference [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
+/// `prepare` and `apply` over many particles (full chunks of lanes and a partial one, on every
+/// instruction set: 70 particles are one full chunk of prepare's 64 `f32` lanes on AVX-512 and
+/// a partial one) against the reference [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
 /// `M_p = d_force_matrix(Σ_j δu_j ∇w_jpᵀ)`, summed in f64. Tolerance per node component:
 /// the single-particle test's `1024 ε` times the sum over particles of each one's largest
 /// node contribution.
@@ -318,7 +319,7 @@ where
     Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    let (cells, hf, n) = (12, 0.05, 21);
+    let (cells, hf, n) = (12, 0.05, 70);
     let h = T::from_f64(hf);
     let eps = T::EPSILON.to_f64();
     for (name, base) in materials::<T>() {

@@ -265,7 +265,8 @@ fn layouts_and_positions_give_the_same_bits() {
 /// of eight particles take their per-particle pass (reads, checks, moduli, stress factors) on
 /// lanes in f32, and a particle alone takes it on its own. The batch's other particles are ≥ 4 cells
 /// away along axis 0 (disjoint stencils); one of them is invalid, so that its group of eight
-/// takes the pass one by one.
+/// takes the pass one by one. The batch of 80 spans two chunks of the widest lanes (64 in
+/// `f32` on AVX-512), and the particle moves through lanes on both sides of 32 and of 64.
 fn batch_index_independent<T: BatchReal, const D: usize>()
 where
     Dim<D>: LaneDim<D>,
@@ -284,7 +285,7 @@ where
     };
     for (name, mat) in materials::<T>() {
         let mut rng = Pcg64::seed_from_u64(5);
-        let mut near = particles::<T, D>(&mut rng, 40, hf, cells, &mat);
+        let mut near = particles::<T, D>(&mut rng, 80, hf, cells, &mat);
         for q in near.iter_mut() {
             let c = q.x[0] / h;
             q.x[0] = T::from_f64(4.0) * h + (c - c.floor()) * h;
@@ -292,7 +293,7 @@ where
         // Particle 33 (group 32..40) has a NaN velocity.
         near[33].v[0] = T::from_f64(f64::NAN);
         for isa in Isa::available() {
-            for k in [0usize, 5, 17, 31, 36, 39] {
+            for k in [0usize, 5, 17, 31, 36, 39, 47, 63, 64, 79] {
                 let mut p = near[k];
                 p.x[0] += T::from_f64(5.0) * h;
                 let mut batch = near.clone();

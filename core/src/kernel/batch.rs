@@ -31,6 +31,22 @@ use core::ptr;
 /// The widest lane type of any path (two `f32×16`).
 pub const MAX_LANES: usize = 32;
 
+/// The lanes of [`Lane::Wide`] of the widest lane type (four `f32×16`): the chunks of the
+/// particle calls that run the decomposition (P2G, the force differential's prepare), whose
+/// Jacobi rotations are latency-bound and fill the FMA pipes better with four independent
+/// vectors than with two. `f64`'s widest chunk has half as many ([`WithWideLanes`]).
+pub const WIDE_LANES: usize = 2 * MAX_LANES;
+
+/// A computation generic over its chunks' lane count `L`, which [`BatchReal`] runs with the
+/// lanes of its widest chunk: [`WIDE_LANES`] for `f32`, half as many for `f64` (the same
+/// bytes), so that buffers sized `[T; L]` fit each scalar's chunks without doubling `f64`'s.
+pub trait WithWideLanes<T> {
+    /// The result.
+    type Out;
+    /// Runs with chunks of at most `L` lanes.
+    fn run<const L: usize>(self) -> Self::Out;
+}
+
 /// Outcome of a batch call that ran: the first failed particle and its status.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BatchStatus {
@@ -52,9 +68,22 @@ impl BatchStatus {
 }
 
 /// Scalars with SIMD paths: `f32` and `f64` (sealed).
-pub trait BatchReal: Real + sealed::Sealed {}
-impl BatchReal for f32 {}
-impl BatchReal for f64 {}
+pub trait BatchReal: Real + sealed::Sealed {
+    /// Runs `f` with this scalar's widest chunk ([`WithWideLanes`]).
+    fn with_wide_lanes<F: WithWideLanes<Self>>(f: F) -> F::Out;
+}
+impl BatchReal for f32 {
+    #[inline(always)]
+    fn with_wide_lanes<F: WithWideLanes<Self>>(f: F) -> F::Out {
+        f.run::<WIDE_LANES>()
+    }
+}
+impl BatchReal for f64 {
+    #[inline(always)]
+    fn with_wide_lanes<F: WithWideLanes<Self>>(f: F) -> F::Out {
+        f.run::<{ WIDE_LANES / 2 }>()
+    }
+}
 
 mod sealed {
     /// The vector types of a scalar on each instruction set.
@@ -230,7 +259,7 @@ where
                     (V::mask_bits(bad_z), Error::NonFinite),
                     (V::mask_bits(ovf), Error::Overflow),
                 ];
-                let skip = bits.iter().fold(0u32, |x, (b, _)| x | b);
+                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
                 if let Some(m) = a_m {
                     store_mats::<V, D>(&m, a.ahat.add(start * e), len, skip);
                 }
@@ -366,7 +395,7 @@ where
                 };
                 let [b0, b1, b2, b3, b4] = check_bits::<V>(&ck);
                 let bits = [b0, b1, b2, b3, b4, (V::mask_bits(ovf), Error::Overflow)];
-                let skip = bits.iter().fold(0u32, |x, (b, _)| x | b);
+                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
                 if let Some(m) = a_m {
                     store_mats::<V, D>(&m, a.ahat.add(start * e), len, skip);
                 }
@@ -436,7 +465,7 @@ where
                     (V::mask_bits(!all_finite(&z)), Error::NonFinite),
                     (V::mask_bits(!all_finite(&m)), Error::Overflow),
                 ];
-                let skip = bits.iter().fold(0u32, |x, (b, _)| x | b);
+                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
                 store_mats::<V, D>(&m, a.out.add(start * e), len, skip);
                 first.note(start, &bits, len);
             }

@@ -57,10 +57,11 @@ pub(crate) unsafe fn scatter<V: Lane, const WMAX: usize>(
     dst: *mut V::Scalar,
     stride: usize,
     len: usize,
-    skip: u32,
+    skip: u64,
 ) {
     if len == V::LANES {
-        let keep = !skip;
+        // The batch kernels' chunks have at most 32 lanes (`MAX_LANES`).
+        let keep = !skip as u32;
         for m in 0..w {
             src[m].scatter(dst.add(m), stride, keep);
         }
@@ -125,7 +126,7 @@ pub(crate) unsafe fn store_mats<V: Lane, const D: usize>(
     m: &LMat<V, D>,
     dst: *mut V::Scalar,
     len: usize,
-    skip: u32,
+    skip: u64,
 ) {
     let mut flat = [m[0][0]; 9];
     for j in 0..D {
@@ -138,9 +139,9 @@ pub(crate) unsafe fn store_mats<V: Lane, const D: usize>(
 
 /// The first failure of a chunk, if any, as `(lane, status)`.
 #[inline(always)]
-pub(crate) fn first_error(bits: &[(u32, Error)], len: usize) -> Option<(usize, Error)> {
-    let all = bits.iter().fold(0u32, |a, (b, _)| a | b);
-    let all = all & (u32::MAX >> (32 - len as u32));
+pub(crate) fn first_error(bits: &[(u64, Error)], len: usize) -> Option<(usize, Error)> {
+    let all = bits.iter().fold(0u64, |a, (b, _)| a | b);
+    let all = all & (u64::MAX >> (64 - len as u32));
     if all == 0 {
         return None;
     }
@@ -166,7 +167,7 @@ impl First {
         }
     }
     #[inline(always)]
-    pub(crate) fn note(&mut self, start: usize, bits: &[(u32, Error)], len: usize) {
+    pub(crate) fn note(&mut self, start: usize, bits: &[(u64, Error)], len: usize) {
         if self.err.is_none() {
             if let Some((l, e)) = first_error(bits, len) {
                 self.at = start + l;
@@ -191,7 +192,7 @@ pub(crate) fn none<V: Lane>() -> V::Mask {
 
 /// The check masks of [`super::evaluate`] as bit sets with their statuses, in order of precedence.
 #[inline(always)]
-pub(crate) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u32, Error); 5] {
+pub(crate) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u64, Error); 5] {
     [
         (V::mask_bits(ck.f_non_finite), Error::NonFinite),
         (V::mask_bits(ck.j_non_positive), Error::NonPositiveJ),

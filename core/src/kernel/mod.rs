@@ -152,7 +152,7 @@ impl<M: Copy + core::ops::BitOr<Output = M>> Checks<M> {
 /// it passed, in order of precedence.
 #[inline]
 #[must_use]
-pub fn lane_error(bits: &[(u32, Error)], l: usize) -> Option<Error> {
+pub fn lane_error(bits: &[(u64, Error)], l: usize) -> Option<Error> {
     bits.iter().find(|(b, _)| b >> l & 1 == 1).map(|&(_, e)| e)
 }
 

@@ -59,6 +59,11 @@ pub trait Lane:
         + BitAnd<Output = Self::Mask>
         + BitOr<Output = Self::Mask>
         + Not<Output = Self::Mask>;
+    /// Twice these lanes in two independent vectors ([`X2`]); one scalar stays one scalar.
+    /// Loops whose per-lane work is a long dependency chain (the decomposition's Jacobi
+    /// rotations, each waiting on the last) fill the FMA pipes better with more independent
+    /// vectors.
+    type Wide: Lane<Scalar = Self::Scalar>;
     /// Number of lanes.
     const LANES: usize;
     /// Whether [`Lane::quad_sums`] runs in registers (else through memory, and a caller
@@ -188,9 +193,9 @@ pub trait Lane:
     /// Neither NaN nor infinite.
     #[must_use]
     fn is_finite(self) -> Self::Mask;
-    /// Bit `i` set when lane `i` of `m` is true.
+    /// Bit `i` set when lane `i` of `m` is true (at most 64 lanes).
     #[must_use]
-    fn mask_bits(m: Self::Mask) -> u32;
+    fn mask_bits(m: Self::Mask) -> u64;
     /// Binary exponent `e` with `self = m·2ᵉ`, `0.5 ≤ |m| < 1` (0 for zero or non-finite), as
     /// an integer-valued lane; exact for subnormals too (as `frexp`).
     #[must_use]
@@ -293,7 +298,7 @@ pub trait Lane:
     #[inline(always)]
     #[must_use]
     fn all(m: Self::Mask) -> bool {
-        Self::mask_bits(m) == (u32::MAX >> (32 - Self::LANES as u32))
+        Self::mask_bits(m) == (u64::MAX >> (64 - Self::LANES as u32))
     }
     /// Some lane of `m` true.
     #[inline(always)]
@@ -325,6 +330,7 @@ pub(crate) fn quad_sums_in_memory<V: Lane>(v: [V; 4]) -> V {
 impl<T: Real> Lane for T {
     type Scalar = T;
     type Mask = bool;
+    type Wide = T;
     const LANES: usize = 1;
 
     #[inline(always)]
@@ -434,8 +440,8 @@ impl<T: Real> Lane for T {
         Real::is_finite(self)
     }
     #[inline(always)]
-    fn mask_bits(m: bool) -> u32 {
-        u32::from(m)
+    fn mask_bits(m: bool) -> u64 {
+        u64::from(m)
     }
     #[inline(always)]
     fn exponent(self) -> T {

@@ -76,6 +76,7 @@ impl<V: Lane> Neg for X2<V> {
 impl<V: Lane> Lane for X2<V> {
     type Scalar = V::Scalar;
     type Mask = X2Mask<V::Mask>;
+    type Wide = X2<Self>;
     const LANES: usize = 2 * V::LANES;
 
     #[inline(always)]
@@ -227,7 +228,7 @@ impl<V: Lane> Lane for X2<V> {
         X2Mask([self.0[0].is_finite(), self.0[1].is_finite()])
     }
     #[inline(always)]
-    fn mask_bits(m: Self::Mask) -> u32 {
+    fn mask_bits(m: Self::Mask) -> u64 {
         V::mask_bits(m.0[0]) | V::mask_bits(m.0[1]) << V::LANES
     }
     #[inline(always)]

@@ -246,8 +246,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         h: T,
         xs: &[[T; D]],
         out: &mut [Self],
-    ) -> u32 {
-        const MAX: usize = 32;
+    ) -> u64 {
+        const MAX: usize = 64;
         let n = V::LANES;
         debug_assert!(n <= MAX && xs.len() >= n && out.len() >= n);
         let inv_h = T::ONE / h;
@@ -255,13 +255,13 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         if !(h.is_finite() && h > T::ZERO && inv_h.is_finite()) || bad_face {
             return 0;
         }
-        let mut done = u32::MAX >> (32 - n);
+        let mut done = u64::MAX >> (64 - n);
         // Per axis, the lane vectors `⌊ξ⌋` (as integers), `fx` and the K weights and
         // derivatives, written into the stencils as records (`Lane::store_records`: `f32`
         // lanes transpose in registers and store whole rows; others store scalars, never
         // scatter instructions, which are slow on AMD Zen 4).
         let mut fl_buf = [[0i32; MAX]; 3];
-        let mut lo_bits = [0u32; 3];
+        let mut lo_bits = [0u64; 3];
         let zero = V::splat(T::ZERO);
         let mut fxs = [zero; 3];
         let mut xa = [T::ZERO; MAX];
@@ -294,7 +294,7 @@ impl<T: Real, const D: usize> Stencil<T, D> {
                     V::select(below, one, zero)
                 }
                 Kernel::Cubic => {
-                    lo_bits[a] = u32::MAX;
+                    lo_bits[a] = u64::MAX;
                     one
                 }
             };

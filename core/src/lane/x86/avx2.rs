@@ -62,6 +62,7 @@ unsafe fn mask4(n: usize) -> __m256i {
 impl Lane for F32x8 {
     type Scalar = f32;
     type Mask = M32x8;
+    type Wide = crate::lane::X2<Self>;
     const LANES: usize = 8;
 
     #[inline(always)]
@@ -203,9 +204,9 @@ impl Lane for F32x8 {
         self.abs().lt(Self::splat(f32::INFINITY))
     }
     #[inline(always)]
-    fn mask_bits(m: M32x8) -> u32 {
+    fn mask_bits(m: M32x8) -> u64 {
         // SAFETY: see the module docs.
-        unsafe { _mm256_movemask_ps(m.0) as u32 }
+        u64::from(unsafe { _mm256_movemask_ps(m.0) } as u32)
     }
     #[inline(always)]
     fn exponent(self) -> Self {
@@ -376,6 +377,7 @@ const TWO52: f64 = 4_503_599_627_370_496.0;
 impl Lane for F64x4 {
     type Scalar = f64;
     type Mask = M64x4;
+    type Wide = crate::lane::X2<Self>;
     const LANES: usize = 4;
 
     #[inline(always)]
@@ -492,9 +494,9 @@ impl Lane for F64x4 {
         self.abs().lt(Self::splat(f64::INFINITY))
     }
     #[inline(always)]
-    fn mask_bits(m: M64x4) -> u32 {
+    fn mask_bits(m: M64x4) -> u64 {
         // SAFETY: see the module docs.
-        unsafe { _mm256_movemask_pd(m.0) as u32 }
+        u64::from(unsafe { _mm256_movemask_pd(m.0) } as u32)
     }
     #[inline(always)]
     fn exponent(self) -> Self {

@@ -73,6 +73,7 @@ macro_rules! avx512_lane {
         impl Lane for $v {
             type Scalar = $t;
             type Mask = $k;
+            type Wide = crate::lane::X2<Self>;
             const LANES: usize = $n;
 
             #[inline(always)]
@@ -190,8 +191,8 @@ macro_rules! avx512_lane {
                 self.abs().lt(Self::splat(<$t>::INFINITY))
             }
             #[inline(always)]
-            fn mask_bits(m: $k) -> u32 {
-                u32::from(m.0)
+            fn mask_bits(m: $k) -> u64 {
+                u64::from(m.0)
             }
             #[inline(always)]
             fn exponent(self) -> Self {

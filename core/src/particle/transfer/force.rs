@@ -15,7 +15,7 @@ use super::OutChannel;
 use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
 use super::{Particles, Reads};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, MAX_LANES};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, WIDE_LANES};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::LMat;
@@ -131,6 +131,12 @@ where
     const AVX512_VL: bool = true;
 
     #[inline(always)]
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // Chunks of twice the kernel lanes: the decomposition's rotations are latency-bound.
+        self.run::<V::Wide>()
+    }
+
+    #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
         let lanes = V::LANES;
         let sl = slot_len(D);
@@ -138,9 +144,9 @@ where
         let mut start = 0;
         while start < self.n {
             let len = lanes.min(self.n - start);
-            let mut fbuf = [[T::ZERO; MAX_LANES]; 9];
-            let mut sbuf = [[T::ZERO; MAX_LANES]; 4];
-            let mut err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            let mut fbuf = [[T::ZERO; WIDE_LANES]; 9];
+            let mut sbuf = [[T::ZERO; WIDE_LANES]; 4];
+            let mut err: [Option<Error>; WIDE_LANES] = [None; WIDE_LANES];
             for l in 0..lanes {
                 let pre = if l < len {
                     // SAFETY: `prepare`'s contract.
@@ -184,7 +190,7 @@ where
             let bits = check_bits::<V>(&ck);
             let mut ent = [V::splat(T::ZERO); slot_len(3)];
             entries(&b, &mut ent);
-            let mut out = [[T::ZERO; MAX_LANES]; slot_len(3)];
+            let mut out = [[T::ZERO; WIDE_LANES]; slot_len(3)];
             let mut chk = V::splat(T::ZERO);
             for (o, v) in ent.iter().enumerate().take(sl).skip(1) {
                 // v − v is 0 for finite v and NaN otherwise: one finiteness sum per lane.
@@ -194,7 +200,7 @@ where
                 }
                 v.store(&mut out[o][..lanes]);
             }
-            let mut ok_bits = [T::ZERO; MAX_LANES];
+            let mut ok_bits = [T::ZERO; WIDE_LANES];
             chk.store(&mut ok_bits[..lanes]);
             for l in 0..len {
                 let i = start + l;

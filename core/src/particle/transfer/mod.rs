@@ -205,7 +205,7 @@ unsafe fn chunk_stencils<T: Real, R: crate::lane::Lane<Scalar = T>, const D: usi
     (start, len): (usize, usize),
     xs: &mut [[T; D]],
     out: &mut [Stencil<T, D>],
-) -> u32 {
+) -> u64 {
     for (k, xk) in xs.iter_mut().enumerate().take(len) {
         *xk = rd_vec::<T, D>(x, start + k);
     }

@@ -15,7 +15,7 @@
 
 use super::{momentum0, P2gOp, Ready};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{BatchReal, MAX_LANES};
+use crate::kernel::batch::BatchReal;
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
 use crate::mat::{Mat, Matrix};
@@ -25,38 +25,38 @@ use crate::particle::transfer::rd;
 use crate::particle::{Dilation, Phase};
 use crate::scalar::Real;
 
-/// The transposed per-particle data of a chunk (entry `[c][l]`: component `c` of lane `l`;
-/// matrices column-major, `c = i + d·j`).
-pub(super) struct ChunkBufs<T> {
+/// The transposed per-particle data of a chunk of at most `L` particles (entry `[c][l]`:
+/// component `c` of lane `l`; matrices column-major, `c = i + d·j`).
+pub(super) struct ChunkBufs<T, const L: usize> {
     /// `F_E`, the stress kernels' input.
-    pub f: [[T; MAX_LANES]; 9],
+    pub f: [[T; L]; 9],
     /// `μ` (0: no decomposition).
-    pub mu: [T; MAX_LANES],
+    pub mu: [T; L],
     /// The deviatoric Kirchhoff stress `Â F_Eᵀ` (0 where `μ = 0`).
-    pub tau: [[T; MAX_LANES]; 9],
+    pub tau: [[T; L]; 9],
     /// The dilational Kirchhoff stress `λ(J_E − 1)J_E` (0 unless the dilation is explicit).
-    pub k: [T; MAX_LANES],
+    pub k: [T; L],
     /// `−V⁰`.
-    pub nvol: [T; MAX_LANES],
+    pub nvol: [T; L],
     /// `−V⁰ τ`.
-    pub fm: [[T; MAX_LANES]; 9],
+    pub fm: [[T; L]; 9],
     /// `m C h`.
-    pub mch: [[T; MAX_LANES]; 9],
+    pub mch: [[T; L]; 9],
     /// `m v`.
-    pub mv: [[T; MAX_LANES]; 3],
+    pub mv: [[T; L]; 3],
     /// `m`.
-    pub mass: [T; MAX_LANES],
+    pub mass: [T; L],
     /// `m c`, `m c T`, `m κ` (heat on).
-    pub heat: [[T; MAX_LANES]; 3],
+    pub heat: [[T; L]; 3],
     /// Lanes whose factors are finite (bit `l` for lane `l`).
-    pub finite: u32,
+    pub finite: u64,
 }
 
-impl<T: Real> ChunkBufs<T> {
+impl<T: Real, const L: usize> ChunkBufs<T, L> {
     /// Zeros.
     #[inline(always)]
     pub fn new() -> Self {
-        let z = [T::ZERO; MAX_LANES];
+        let z = [T::ZERO; L];
         Self {
             f: [z; 9],
             mu: z,
@@ -95,7 +95,7 @@ unsafe fn load<T: Real, R: Lane<Scalar = T>>(p: *const T, i: usize) -> R {
 
 /// `R::LANES` scalars to `b[l0..]`.
 #[inline(always)]
-fn put<T: Real, R: Lane<Scalar = T>>(b: &mut [T; MAX_LANES], l0: usize, v: R) {
+fn put<T: Real, R: Lane<Scalar = T>, const L: usize>(b: &mut [T; L], l0: usize, v: R) {
     v.store(&mut b[l0..l0 + R::LANES]);
 }
 
@@ -123,18 +123,18 @@ where
     /// # Safety
     /// The particle arrays of [`super::p2g`]'s contract hold these particles.
     #[inline(always)]
-    pub(super) unsafe fn pre_lanes<R: Lane<Scalar = T>>(
+    pub(super) unsafe fn pre_lanes<R: Lane<Scalar = T>, const L: usize>(
         &self,
         start: usize,
         l0: usize,
-        b: &mut ChunkBufs<T>,
+        b: &mut ChunkBufs<T, L>,
         xs: &mut [[T; D]],
     ) -> Option<bool> {
         let (ps, m) = (self.ps, self.material);
         let n = R::LANES;
         let zero = R::splat(T::ZERO);
         // Phases (solid when `phase` is null) and the material's validity for each.
-        let mut liq = [T::ZERO; MAX_LANES];
+        let mut liq = [T::ZERO; L];
         let (mut solids, mut liquids) = (ps.phase.is_null(), false);
         if !ps.phase.is_null() {
             for (l, f) in liq.iter_mut().enumerate().take(n) {
@@ -232,7 +232,7 @@ where
         put(&mut b.k, l0, k);
         put(&mut b.nvol, l0, -vol);
         put(&mut b.mass, l0, mass);
-        let all = (1u32 << n) - 1;
+        let all = (1u64 << n) - 1;
         b.finite = b.finite & !(all << l0) | R::mask_bits(fin) << l0;
         R::store_records(xs.as_mut_ptr().add(l0) as *mut T, D, &x);
         Some(R::any(zero.lt(mu)))
@@ -241,9 +241,9 @@ where
     /// The node loop inputs of lane `l` of `b` (its pass ran on lanes; `fm` and its check set
     /// by [`fm_lanes`]), for its stencil `s`: [`Self::ready`]'s values and errors.
     #[inline(always)]
-    pub(super) fn ready_lane<'s>(
+    pub(super) fn ready_lane<'s, const L: usize>(
         &self,
-        b: &ChunkBufs<T>,
+        b: &ChunkBufs<T, L>,
         l: usize,
         s: &'s Stencil<T, D>,
     ) -> Result<Ready<'s, T, D>> {
@@ -284,8 +284,8 @@ where
 /// `explicit`), then the product; a lane whose `fm` is not finite is cleared in `b.finite`
 /// (a finite stress times a finite `−V⁰` can still overflow).
 #[inline(always)]
-pub(super) fn fm_lanes<T: Real, V: Lane<Scalar = T>, const D: usize>(
-    b: &mut ChunkBufs<T>,
+pub(super) fn fm_lanes<T: Real, V: Lane<Scalar = T>, const D: usize, const L: usize>(
+    b: &mut ChunkBufs<T, L>,
     tau: &LMat<V, D>,
     explicit: bool,
     lanes: usize,

@@ -6,7 +6,7 @@
 use super::lanes::{fm_lanes, ChunkBufs};
 use super::{P2gOp, Pre, Ready, Run};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, MAX_LANES};
+use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithWideLanes};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
@@ -19,6 +19,7 @@ use crate::particle::transfer::nodes::{
 use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use crate::particle::transfer::BatchStatus;
 use crate::particle::{Dilation, Kernel};
+use core::marker::PhantomData;
 use core::mem::MaybeUninit;
 
 /// The particle loop's channel sets (its `SET` parameter): mass and momentum along every axis
@@ -29,7 +30,11 @@ const ANY_CHANNELS: u8 = 0;
 
 /// Where a particle's pass is: its scalar pass, or its lane of the chunk's buffers (when that
 /// ran on lanes); and its position.
-type Source<'b, T, const D: usize> = (&'b Pre<T, D>, Option<(&'b ChunkBufs<T>, usize)>, &'b [T; D]);
+type Source<'b, T, const D: usize, const L: usize> = (
+    &'b Pre<T, D>,
+    Option<(&'b ChunkBufs<T, L>, usize)>,
+    &'b [T; D],
+);
 
 impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
 where
@@ -267,10 +272,16 @@ where
     /// `x` its position; `lane_stencil` its stencil if the lanes made it.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn finish<R: Lane<Scalar = T>, const K: usize, const N: usize, const SET: u8>(
+    unsafe fn finish<
+        R: Lane<Scalar = T>,
+        const K: usize,
+        const N: usize,
+        const SET: u8,
+        const L: usize,
+    >(
         &mut self,
         i: usize,
-        (pre, from_lanes, x): Source<'_, T, D>,
+        (pre, from_lanes, x): Source<'_, T, D, L>,
         tau_dev: Mat<T, D>,
         lane_stencil: Option<&Stencil<T, D>>,
         (tile, run): (&mut Tile<R, D>, &mut Run<T, D>),
@@ -316,14 +327,34 @@ where
 
     #[inline(always)]
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // Chunks of `V::Wide`: the decomposition's Jacobi rotations are latency-bound, and
+        // four independent vectors fill the FMA pipes better than two.
+        T::with_wide_lanes(Chunks::<'_, '_, T, D, V::Wide, R>(self, PhantomData))
+    }
+}
+
+/// [`P2gOp`]'s particle loop on chunks of `V` (at most `L` lanes: the buffers' size).
+struct Chunks<'o, 'a, T, const D: usize, V, R>(&'o mut P2gOp<'a, T, D>, PhantomData<(V, R)>);
+
+impl<T: BatchReal, const D: usize, V: Lane<Scalar = T>, R: Lane<Scalar = T>> WithWideLanes<T>
+    for Chunks<'_, '_, T, D, V, R>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    type Out = BatchStatus;
+
+    #[inline(always)]
+    fn run<const L: usize>(self) -> BatchStatus {
+        let op = self.0;
         // The usual channel sets get particle loops of their own for the quadratic kernel
         // (the channel terms known at compile time); other sets, and the cubic kernel, run
         // the per-channel form. Chosen once per call.
-        match (self.args.kernel, self.fixed) {
-            (Kernel::Quadratic, Some(heat)) if D == 2 => self.run_fixed::<V, R, 3, 9>(heat),
-            (Kernel::Quadratic, Some(heat)) => self.run_fixed::<V, R, 3, 27>(heat),
-            _ => with_nodes!(self.args.kernel, D, |K, N| {
-                self.run_nodes::<V, R, K, N, ANY_CHANNELS>()
+        match (op.args.kernel, op.fixed) {
+            (Kernel::Quadratic, Some(heat)) if D == 2 => op.run_fixed::<V, R, 3, 9, L>(heat),
+            (Kernel::Quadratic, Some(heat)) => op.run_fixed::<V, R, 3, 27, L>(heat),
+            _ => with_nodes!(op.args.kernel, D, |K, N| {
+                op.run_nodes::<V, R, K, N, ANY_CHANNELS, L>()
             }),
         }
     }
@@ -337,18 +368,25 @@ where
     /// The particle loop for a fixed channel set: mass and momentum, then with `heat` the
     /// heat channels.
     #[inline(always)]
-    fn run_fixed<V: Lane<Scalar = T>, R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    fn run_fixed<
+        V: Lane<Scalar = T>,
+        R: Lane<Scalar = T>,
+        const K: usize,
+        const N: usize,
+        const L: usize,
+    >(
         &mut self,
         heat: bool,
     ) -> BatchStatus {
         if heat {
-            self.run_nodes::<V, R, K, N, WITH_HEAT>()
+            self.run_nodes::<V, R, K, N, WITH_HEAT, L>()
         } else {
-            self.run_nodes::<V, R, K, N, MASS_MOMENTUM>()
+            self.run_nodes::<V, R, K, N, MASS_MOMENTUM, L>()
         }
     }
 
-    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`).
+    /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`), on chunks of `V`
+    /// (at most `L` lanes).
     #[inline(always)]
     fn run_nodes<
         V: Lane<Scalar = T>,
@@ -356,10 +394,12 @@ where
         const K: usize,
         const N: usize,
         const SET: u8,
+        const L: usize,
     >(
         &mut self,
     ) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
+        debug_assert!(V::LANES <= L);
         let oc = node_offsets::<T, D, K, N>();
         let mut tile = Tile::<R, D>::new();
         // The tile lane vectors of the particle being added (filled per particle for the
@@ -373,33 +413,33 @@ where
         let lanes = V::LANES;
         // The chunk's per-particle data on lanes (see `p2g/lanes.rs`); bit `l` of `fast` when
         // lane `l`'s pass ran on lanes.
-        let mut b = ChunkBufs::<T>::new();
+        let mut b = ChunkBufs::<T, L>::new();
         let on_lanes = self.lanes_ok();
         let explicit = self.material.dilation == Dilation::Explicit;
         // The scalar passes of the other lanes, built in place (see `pre_into`); `live[l]`
         // when lane `l`'s succeeded.
-        let mut pres = [Pre::<T, D>::blank(); MAX_LANES];
-        let mut live = [false; MAX_LANES];
+        let mut pres = [Pre::<T, D>::blank(); L];
+        let mut live = [false; L];
         // The chunk's positions and stencils (on lanes, see `Stencil::new_lanes`).
         let (kernel, grid, h) = (self.args.kernel, self.args.grid, self.args.h);
-        let mut xs = [[T::ZERO; D]; MAX_LANES];
-        let mut stencils = [Stencil::blank(kernel, h); MAX_LANES];
+        let mut xs = [[T::ZERO; D]; L];
+        let mut stencils = [Stencil::blank(kernel, h); L];
         let mut start = 0;
         while start < self.n {
             let len = lanes.min(self.n - start);
             let mut any_mu = false;
-            let mut fast = 0u32;
+            let mut fast = 0u64;
             let mut g = 0;
             while g < len {
                 let gl = R::LANES.min(len - g);
                 // SAFETY: `p2g`'s contract: the arrays hold `n` particles.
                 let pass = match on_lanes && gl == R::LANES {
-                    true => unsafe { self.pre_lanes::<R>(start + g, g, &mut b, &mut xs) },
+                    true => unsafe { self.pre_lanes::<R, L>(start + g, g, &mut b, &mut xs) },
                     false => None,
                 };
                 if let Some(mu) = pass {
                     any_mu |= mu;
-                    fast |= ((1u32 << gl) - 1) << g;
+                    fast |= ((1u64 << gl) - 1) << g;
                     for lv in &mut live[g..g + gl] {
                         *lv = true;
                     }
@@ -432,7 +472,7 @@ where
                 b.blank_lane::<D>(l);
             }
             let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils);
-            let mut lane_err: [Option<Error>; MAX_LANES] = [None; MAX_LANES];
+            let mut lane_err: [Option<Error>; L] = [None; L];
             // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
             let mut tau: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
             if any_mu {
@@ -475,7 +515,7 @@ where
                     let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
-                        self.finish::<R, K, N, SET>(
+                        self.finish::<R, K, N, SET, L>(
                             start + l,
                             (&pres[l], from_lanes, &xs[l]),
                             tau,
