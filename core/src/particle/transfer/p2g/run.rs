@@ -6,7 +6,7 @@
 use super::lanes::{fm_lanes, ChunkBufs};
 use super::{P2gOp, Pre, Ready, Run};
 use crate::error::{Error, Result};
-use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithWideLanes};
+use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithChunks};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
@@ -327,17 +327,16 @@ where
 
     #[inline(always)]
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        // Chunks of `V::Wide`: the decomposition's Jacobi rotations are latency-bound, and
-        // four independent vectors fill the FMA pipes better than two.
-        T::with_wide_lanes(Chunks::<'_, '_, T, D, V::Wide, R>(self, PhantomData))
+        // In f32 chunks of `V::Wide` (the decomposition's Jacobi rotations are latency-bound,
+        // and four independent vectors fill the FMA pipes better than two); see `with_chunks`.
+        T::with_chunks::<V, _>(Chunks::<'_, '_, T, D, R>(self, PhantomData))
     }
 }
 
-/// [`P2gOp`]'s particle loop on chunks of `V` (at most `L` lanes: the buffers' size).
-struct Chunks<'o, 'a, T, const D: usize, V, R>(&'o mut P2gOp<'a, T, D>, PhantomData<(V, R)>);
+/// [`P2gOp`]'s particle loop with rows `R`, on the chunks [`BatchReal::with_chunks`] picks.
+struct Chunks<'o, 'a, T, const D: usize, R>(&'o mut P2gOp<'a, T, D>, PhantomData<R>);
 
-impl<T: BatchReal, const D: usize, V: Lane<Scalar = T>, R: Lane<Scalar = T>> WithWideLanes<T>
-    for Chunks<'_, '_, T, D, V, R>
+impl<T: BatchReal, const D: usize, R: Lane<Scalar = T>> WithChunks<T> for Chunks<'_, '_, T, D, R>
 where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -345,7 +344,7 @@ where
     type Out = BatchStatus;
 
     #[inline(always)]
-    fn run<const L: usize>(self) -> BatchStatus {
+    fn run<V: Lane<Scalar = T>, const L: usize>(self) -> BatchStatus {
         let op = self.0;
         // The usual channel sets get particle loops of their own for the quadratic kernel
         // (the channel terms known at compile time); other sets, and the cubic kernel, run
