@@ -54,8 +54,9 @@
  *
  * Stack. Calls run on the calling thread's stack: the kernels (single and ampm_*_batch) use at
  * most 32 KiB of it, the particle calls (P2G, G2P, force prepare and apply) at most 96 KiB. The
- * largest measured is about 64 KiB, P2G in 3D f64 with every channel, which sums node values
- * in local tiles (c_tests/test_stack measures every call on every instruction set). Run the
+ * largest measured is about 73 KiB, P2G in 3D f32 with every channel on AVX-512, which sums
+ * node values in local tiles and works on chunks of up to 64 particles (c_tests/test_stack
+ * measures every call on every instruction set). Run the
  * particle calls on threads or fibers with at least 96 KiB of stack.
  *
  * Instruction sets. Batch calls run on the widest instruction set the CPU supports (AVX-512
