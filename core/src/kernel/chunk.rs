@@ -60,7 +60,9 @@ pub(crate) unsafe fn scatter<V: Lane, const WMAX: usize>(
     skip: u64,
 ) {
     if len == V::LANES {
-        // The batch kernels' chunks have at most 32 lanes (`MAX_LANES`).
+        // The batch kernels' chunks have at most 32 lanes (`MAX_LANES`): `Lane::scatter`
+        // takes 32 bits.
+        debug_assert!(V::LANES <= MAX_LANES);
         let keep = !skip as u32;
         for m in 0..w {
             src[m].scatter(dst.add(m), stride, keep);

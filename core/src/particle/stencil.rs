@@ -247,7 +247,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         xs: &[[T; D]],
         out: &mut [Self],
     ) -> u64 {
-        const MAX: usize = 64;
+        // The widest chunk of any caller (P2G's `f32` chunks on AVX-512).
+        const MAX: usize = crate::kernel::batch::WIDE_LANES;
         let n = V::LANES;
         debug_assert!(n <= MAX && xs.len() >= n && out.len() >= n);
         let inv_h = T::ONE / h;
