@@ -1,236 +1,19 @@
-//! The force differential of an implicit step through a grid view: [`prepare`] once per Newton
-//! step, [`apply`] once per Krylov iteration (the math is in [`crate::particle::implicit`]).
-//!
-//! `apply` maps node displacements `δu_j` (m; `Δt δv_j` for backward Euler) to node force
-//! differentials `δf_i = Σ_p M_p ∇w_ip` (N), `M_p = 𝒜_p(Σ_j δu_j ∇w_jpᵀ)`, scatter-added into the
-//! `df` channels: the host zeroes them before the call. This is `δf = K δu` with the stiffness
-//! `K = ∂f/∂x` (symmetric; negative semi-definite with the projected Hessian). A backward-Euler
-//! step solves `(M − Δt² K) v = M v* + Δt f` on the grid: the host's operator is
-//! `v ↦ m_i v_i − Δt · apply(Δt v)_i`.
+//! [`apply()`]: node displacements to node force differentials through the prepared data, once
+//! per Krylov iteration.
 
-use super::field_sums::node_field_sums;
-use super::nodes::{add, nodes, rel_base, restore, table, with_nodes};
-use super::tile::{axis0, set_grad, Coef, Tile, MAX_RUN, TILE_X};
-use super::OutChannel;
-use super::{chunk_stencils, rd_vec, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
-use super::{Particles, Reads};
+use super::ForceView;
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, WIDE_LANES};
-use crate::kernel::chunk::check_bits;
-use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
-use crate::lane::lmat::LMat;
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
-use crate::particle::implicit::{apply_entries, apply_slot, blocks, entries, slot_len, tag};
+use crate::particle::implicit::{apply_entries, apply_slot, slot_len, tag};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
-use crate::particle::update::check_particle;
-use crate::particle::{Definiteness, Dilation, Material};
+use crate::particle::transfer::field_sums::node_field_sums;
+use crate::particle::transfer::nodes::{add, nodes, rel_base, restore, table, with_nodes};
+use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_RUN, TILE_X};
+use crate::particle::transfer::{chunk_stencils, rd_vec, BatchStatus, FirstFailure};
 use crate::scalar::Real;
 use core::mem::MaybeUninit;
-use core::ptr;
-
-/// The channels of the force differential: displacements read, force differentials added.
-#[derive(Clone, Copy, Debug)]
-pub struct ForceView<T, const D: usize> {
-    /// The nodes the channels cover.
-    pub nodes: NodeBox<D>,
-    /// Node displacements `δu` per axis (m).
-    pub du: [InChannel<T, D>; D],
-    /// Node force differentials `δf` per axis (N), scatter-added.
-    pub df: [OutChannel<T, D>; D],
-}
-
-/// Prepares the force differential of `n` particles into `slots` (`n·`[`slot_len`]`(d)`
-/// scalars): reads `f_e`, `f_p`, `volume0`, `phase` (and `latent` with phase change). A failed
-/// particle's slot gets tag 0 only, so that [`apply`] refuses it.
-///
-/// Errors per particle: invalid particle or material, the kernels' errors, [`Error::Overflow`].
-/// Whole-call errors (a null array the material needs) are reported for particle 0.
-///
-/// # Safety
-/// The arrays hold `n` particles; `slots` is valid for `n·slot_len(d)` scalars.
-pub unsafe fn prepare<T: BatchReal, const D: usize>(
-    isa: Isa,
-    material: &Material<T>,
-    n: usize,
-    ps: &Particles<T>,
-    slots: *mut T,
-) -> BatchStatus
-where
-    Dim<D>: LaneDim<D>,
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-{
-    let reads = Reads {
-        x: false,
-        motion: false,
-        mass: false,
-    };
-    if n > 0 && (!ps.has(reads, material) || slots.is_null()) {
-        return BatchStatus {
-            first_failed: 0,
-            error: Some(Error::InvalidArgument),
-        };
-    }
-    let mut op = PrepareOp::<T, D> {
-        material,
-        checked: Checked::new(material),
-        n,
-        ps,
-        slots,
-        first: FirstFailure::new(n),
-    };
-    dispatch::<T, _>(isa, &mut op);
-    op.first.status()
-}
-
-struct PrepareOp<'a, T, const D: usize> {
-    material: &'a Material<T>,
-    checked: Checked,
-    n: usize,
-    ps: &'a Particles<T>,
-    slots: *mut T,
-    first: FirstFailure,
-}
-
-/// Per particle: `F_E`, `μ`, `α`, `β`, `−V⁰`.
-type Pre<T, const D: usize> = (Mat<T, D>, [T; 4]);
-
-impl<T: BatchReal, const D: usize> PrepareOp<'_, T, D>
-where
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-{
-    unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
-        let reads = Reads {
-            x: false,
-            motion: false,
-            mass: false,
-        };
-        let p = self.ps.get::<D>(i, reads, self.material)?;
-        self.checked.for_phase(p.phase)?;
-        let (j, j_p) = check_particle(&p)?;
-        let m = self.material.moduli(p.phase, j_p)?;
-        let (alpha, beta) = match self.material.dilation {
-            Dilation::Explicit => {
-                let lj = j / m.inv_lambda;
-                (lj * (j + j - T::ONE), -(lj * (j - T::ONE)))
-            }
-            Dilation::PressureSolve => (T::ZERO, T::ZERO),
-        };
-        if !(alpha.is_finite() && beta.is_finite()) {
-            return Err(Error::Overflow);
-        }
-        Ok((p.f_e, [m.mu, alpha, beta, -p.volume0]))
-    }
-}
-
-impl<T: BatchReal, const D: usize> LaneOp<T> for PrepareOp<'_, T, D>
-where
-    Dim<D>: LaneDim<D>,
-    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-{
-    const AVX512_VL: bool = true;
-
-    #[inline(always)]
-    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        // Chunks of twice the kernel lanes: the decomposition's rotations are latency-bound.
-        self.run::<V::Wide>()
-    }
-
-    #[inline(always)]
-    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        let lanes = V::LANES;
-        let sl = slot_len(D);
-        let psd = self.material.hessian == Definiteness::Projected;
-        let mut start = 0;
-        while start < self.n {
-            let len = lanes.min(self.n - start);
-            let mut fbuf = [[T::ZERO; WIDE_LANES]; 9];
-            let mut sbuf = [[T::ZERO; WIDE_LANES]; 4];
-            let mut err: [Option<Error>; WIDE_LANES] = [None; WIDE_LANES];
-            for l in 0..lanes {
-                let pre = if l < len {
-                    // SAFETY: `prepare`'s contract.
-                    unsafe { self.pre(start + l) }
-                } else {
-                    Err(Error::InvalidArgument)
-                };
-                match pre {
-                    Ok((f, s)) => {
-                        for j in 0..D {
-                            for r in 0..D {
-                                fbuf[r + D * j][l] = f.cols[j][r];
-                            }
-                        }
-                        for (k, x) in s.iter().enumerate() {
-                            sbuf[k][l] = *x;
-                        }
-                    }
-                    Err(e) => {
-                        err[l] = Some(e);
-                        for d in 0..D {
-                            fbuf[d * (D + 1)][l] = T::ONE;
-                        }
-                    }
-                }
-            }
-            let mut f: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
-            for j in 0..D {
-                for r in 0..D {
-                    f[j][r] = V::load(&fbuf[r + D * j][..lanes]);
-                }
-            }
-            let [mu, alpha, beta, nv] = [
-                V::load(&sbuf[0][..lanes]),
-                V::load(&sbuf[1][..lanes]),
-                V::load(&sbuf[2][..lanes]),
-                V::load(&sbuf[3][..lanes]),
-            ];
-            let (co, ck) = evaluate(mu, &f);
-            let b = blocks(&co, alpha, beta, nv, psd);
-            let bits = check_bits::<V>(&ck);
-            let mut ent = [V::splat(T::ZERO); slot_len(3)];
-            entries(&b, &mut ent);
-            let mut out = [[T::ZERO; WIDE_LANES]; slot_len(3)];
-            let mut chk = V::splat(T::ZERO);
-            for (o, v) in ent.iter().enumerate().take(sl).skip(1) {
-                // v − v is 0 for finite v and NaN otherwise: one finiteness sum per lane.
-                #[allow(clippy::eq_op)]
-                {
-                    chk += *v - *v;
-                }
-                v.store(&mut out[o][..lanes]);
-            }
-            let mut ok_bits = [T::ZERO; WIDE_LANES];
-            chk.store(&mut ok_bits[..lanes]);
-            for l in 0..len {
-                let i = start + l;
-                let mut e = err[l];
-                if e.is_none() && sbuf[0][l] > T::ZERO {
-                    e = lane_error(&bits, l);
-                }
-                if e.is_none() && !ok_bits[l].is_finite() {
-                    e = Some(Error::Overflow);
-                }
-                // SAFETY: `prepare`'s contract: `n` slots.
-                unsafe {
-                    let slot = self.slots.add(i * sl);
-                    match e {
-                        None => {
-                            for (o, row) in out.iter().enumerate().take(sl).skip(1) {
-                                ptr::write_unaligned(slot.add(o), row[l]);
-                            }
-                            ptr::write_unaligned(slot, tag::<T>(D));
-                        }
-                        Some(_) => ptr::write_unaligned(slot, T::ZERO),
-                    }
-                }
-                self.first.note(i, e.map_or(Ok(()), Err));
-            }
-            start += len;
-        }
-        self.first.status()
-    }
-}
 
 /// Applies the prepared differential of `n` particles at positions `x` (`n·d`, m; the positions
 /// of the prepare's Newton step) to `view.du`, adding `δf` into `view.df` (collocated grid,
@@ -276,7 +59,7 @@ where
     dispatch::<T, _>(isa, &mut op)
 }
 
-/// The particle loop of [`apply`], run with the instruction set's target features (the
+/// The particle loop of [`apply()`], run with the instruction set's target features (the
 /// per-node arithmetic is written over arrays of nodes for the compiler to vectorise).
 struct ApplyOp<'a, T, const D: usize> {
     kernel: Kernel,
@@ -310,7 +93,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
     /// The particle loop for a kernel with `K` nodes per axis (`N = K^d`): each particle's
-    /// `δf` goes into a node tile ([`super::tile`]) that is added to `df` per run of nearby
+    /// `δf` goes into a node tile ([`crate::particle::transfer::tile`]) that is added to `df` per run of nearby
     /// particles; a run whose sum would not be finite is added again one particle at a time
     /// ([`one`]), which refuses the particles that overflow. Particles go in chunks of
     /// [`TILE_X`]: the chunk's stencils on lanes, then each particle's `G` (reads of `δu`,
@@ -454,7 +237,7 @@ where
     }
 
     /// [`Self::gather`] of particle `i` at `xp` into `s`, `rel` and `G` (in part on error; built
-    /// in place, for the reason given at [`super::Particles::read_into`]); with `lane`, `s`
+    /// in place, for the reason given at [`crate::particle::transfer::Particles::read_into`]); with `lane`, `s`
     /// already holds the stencil of `xp` ([`Stencil::new_lanes`]). Statuses in the order of
     /// the checks: slot, stencil, box, `δu`.
     ///
@@ -561,7 +344,7 @@ unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, c
     Ok(sums.g)
 }
 
-/// One particle of [`apply`] added on its own: `δf_i = M ∇w_i` added per channel, with every
+/// One particle of [`apply()`] added on its own: `δf_i = M ∇w_i` added per channel, with every
 /// old value kept and put back on overflow.
 ///
 /// # Safety
