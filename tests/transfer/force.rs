@@ -308,7 +308,9 @@ fn apply_run_that_overflows_is_added_one_by_one() {
 
 /// `prepare` and `apply` over many particles (full chunks of lanes and a partial one, on every
 /// instruction set: 70 particles are one full chunk of prepare's 64 `f32` lanes on AVX-512 and
-/// a partial one) against the reference [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
+/// a partial one, and eight full chunks of apply's eight and a partial one, each full one
+/// gathered on lanes in 3D `f32` but the one with a refused slot) against the reference
+/// [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
 /// `M_p = d_force_matrix(Σ_j δu_j ∇w_jpᵀ)`, summed in f64. Tolerance per node component:
 /// the single-particle test's `1024 ε` times the sum over particles of each one's largest
 /// node contribution.
@@ -320,6 +322,9 @@ where
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
     let (cells, hf, n) = (12, 0.05, 70);
+    // A particle whose slot is zeroed after the prepare: refused, the rest of its chunk of
+    // eight (particles 8..16) still applied.
+    const REFUSED: usize = 11;
     let h = T::from_f64(hf);
     let eps = T::EPSILON.to_f64();
     for (name, base) in materials::<T>() {
@@ -339,7 +344,10 @@ where
         let len = du.ch[MOM].len();
         let mut want = vec![[0.0f64; D]; len];
         let mut scale = 0.0f64;
-        for p in &ps {
+        for (i, p) in ps.iter().enumerate() {
+            if i == REFUSED {
+                continue;
+            }
             let e = elastic_energy(&mat, p).unwrap();
             let st = Stiffness::new(&e, &mat, p).unwrap();
             let s = Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &p.x).unwrap();
@@ -372,6 +380,7 @@ where
             let st =
                 unsafe { force::prepare::<T, D>(isa, &mat, n, &store.raw(), slots.as_mut_ptr()) };
             assert_eq!(st.error, None, "{name} {isa:?}");
+            slots[REFUSED * slot_len(D)..(REFUSED + 1) * slot_len(D)].fill(T::ZERO);
             let mut df = DenseGrid::<T, D>::new([0; D], [cells; D]);
             let view = ForceView {
                 nodes: du.nodes(),
@@ -390,7 +399,11 @@ where
                     &view,
                 )
             };
-            assert_eq!(st.error, None, "{name} {isa:?}");
+            assert_eq!(
+                (st.first_failed, st.error),
+                (REFUSED, Some(Error::NotPrepared)),
+                "{name} {isa:?}"
+            );
             for (k, w) in want.iter().enumerate() {
                 for a in 0..D {
                     let got = df.ch[FORCE + a][k].to_f64();
