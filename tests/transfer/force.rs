@@ -308,9 +308,9 @@ fn apply_run_that_overflows_is_added_one_by_one() {
 
 /// `prepare` and `apply` over many particles (full chunks of lanes and a partial one, on every
 /// instruction set: 70 particles are one full chunk of prepare's 64 `f32` lanes on AVX-512 and
-/// a partial one, and eight full chunks of apply's eight and a partial one, each full one
-/// gathered on lanes in 3D `f32` but the one with a refused slot) against the reference
-/// [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
+/// a partial one, and eight full chunks of apply's eight and a partial one: each full chunk's
+/// `M` on lanes but the one with the refused slot, whose particles go one by one) against the
+/// reference [`Stiffness`] of each particle: `δf_i = Σ_p M_p ∇w_ip` with
 /// `M_p = d_force_matrix(Σ_j δu_j ∇w_jpᵀ)`, summed in f64. Tolerance per node component:
 /// the single-particle test's `1024 ε` times the sum over particles of each one's largest
 /// node contribution.
