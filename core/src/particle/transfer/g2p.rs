@@ -83,11 +83,7 @@ where
         first_failed: 0,
         error: Some(e),
     };
-    let reads = Reads {
-        x: true,
-        motion: true,
-        mass: true,
-    };
+    let reads = Reads::ALL;
     let heat = material.heat.is_some();
     let vel_missing = match faces {
         Some(f) => (0..D).any(|a| f[a].velocity[a].data.is_null()),
@@ -311,11 +307,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
     DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    let reads = Reads {
-        x: true,
-        motion: true,
-        mass: true,
-    };
+    let reads = Reads::ALL;
     let p = ps.get::<D>(i, reads, material)?;
     checked.for_phase(p.phase)?;
     let sample = sample?;

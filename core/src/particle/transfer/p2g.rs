@@ -117,11 +117,7 @@ where
     if args.impulse_dt < T::ZERO || matches!(args.grid, Grid::Face(a) if a >= D) {
         return bad(Error::InvalidArgument);
     }
-    let reads = Reads {
-        x: true,
-        motion: true,
-        mass: true,
-    };
+    let reads = Reads::ALL;
     if n > 0 && !ps.has(reads, material) {
         return bad(Error::InvalidArgument);
     }
@@ -208,11 +204,7 @@ where
     /// the reason given at [`Particles::read_into`].
     #[inline(always)]
     unsafe fn pre_into(&self, i: usize, out: &mut Pre<T, D>) -> Result<()> {
-        let reads = Reads {
-            x: true,
-            motion: true,
-            mass: true,
-        };
+        let reads = Reads::ALL;
         self.ps
             .read_into::<D>(i, reads, self.material, &mut out.p)?;
         let p = &out.p;

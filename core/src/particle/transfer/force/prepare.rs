@@ -33,11 +33,7 @@ where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    let reads = Reads {
-        x: false,
-        motion: false,
-        mass: false,
-    };
+    let reads = Reads::DEFORMATION;
     if n > 0 && (!ps.has(reads, material) || slots.is_null()) {
         return BatchStatus {
             first_failed: 0,
@@ -56,6 +52,8 @@ where
     op.first.status()
 }
 
+/// The particle loop of [`prepare()`], run with the instruction set's target features; the
+/// first failure is kept in `first`.
 struct PrepareOp<'a, T, const D: usize> {
     material: &'a Material<T>,
     checked: Checked,
@@ -73,11 +71,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
     unsafe fn pre(&self, i: usize) -> Result<Pre<T, D>> {
-        let reads = Reads {
-            x: false,
-            motion: false,
-            mass: false,
-        };
+        let reads = Reads::DEFORMATION;
         let p = self.ps.get::<D>(i, reads, self.material)?;
         self.checked.for_phase(p.phase)?;
         let (j, j_p) = check_particle(&p)?;
