@@ -487,11 +487,11 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
 }
 
 /// The usual channel sets (mass and momentum, then optionally the heat channels, with no force
-/// channel) have particle loops of their own, which on AVX-512 in `f32` sum two channels per
-/// sixteen-lane row vector. Their node sums have the bits of the per-channel form (the same
-/// channels with the force channels also written), and the same bits on every vector
-/// instruction set, with and without the impulse term. The particles are sorted by cell, as
-/// a host sorts them, so that long runs share a node tile.
+/// channel) have particle loops of their own, with the channel terms known at compile time.
+/// Their node sums have the bits of the per-channel form (the same channels with the force
+/// channels also written), and the same bits on every vector instruction set, with and
+/// without the impulse term. The particles are sorted by cell, as a host sorts them, so that
+/// long runs share a node tile.
 fn fixed_channel_sets_give_the_per_channel_bits<T: BatchReal, const D: usize>()
 where
     Dim<D>: LaneDim<D>,

@@ -64,15 +64,8 @@ pub trait Lane:
     /// rotations, each waiting on the last) fill the FMA pipes better with more independent
     /// vectors.
     type Wide: Lane<Scalar = Self::Scalar>;
-    /// Sixteen lanes of this type's instruction set, for two eight-lane node rows side by
-    /// side (two channels of a P2G node tile): one register where the instruction set has
-    /// sixteen-lane vectors of this scalar ([`Lane::ONE_REGISTER`]), else two or more vectors.
-    type Rows16: Lane<Scalar = Self::Scalar>;
     /// Number of lanes.
     const LANES: usize;
-    /// Whether the type is one machine register (so that two channels' rows side by side in
-    /// it cost one instruction per operation, not two).
-    const ONE_REGISTER: bool = false;
     /// Whether [`Lane::quad_sums`] runs in registers (else through memory, and a caller
     /// summing stored lanes itself in the same order is faster).
     const QUAD_SUMS_IN_REGISTERS: bool = false;
@@ -83,18 +76,6 @@ pub trait Lane:
     /// Every lane `x`.
     #[must_use]
     fn splat(x: Self::Scalar) -> Self;
-    /// Lanes `0..LANES/2` `x`, the others `y` (`LANES` even). By default through memory; the
-    /// pair types and the sixteen-lane `f32` type set the halves in registers.
-    #[inline(always)]
-    #[must_use]
-    fn splat2(x: Self::Scalar, y: Self::Scalar) -> Self {
-        let mut b = [Self::Scalar::ZERO; 32];
-        let h = Self::LANES / 2;
-        for (i, v) in b.iter_mut().enumerate().take(Self::LANES) {
-            *v = if i < h { x } else { y };
-        }
-        Self::load(&b)
-    }
     /// Lanes `s[0..LANES]` (`s.len() ≥ LANES`).
     #[must_use]
     fn load(s: &[Self::Scalar]) -> Self;
@@ -350,7 +331,6 @@ impl<T: Real> Lane for T {
     type Scalar = T;
     type Mask = bool;
     type Wide = T;
-    type Rows16 = X2<X2<X2<X2<T>>>>;
     const LANES: usize = 1;
 
     #[inline(always)]

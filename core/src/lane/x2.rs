@@ -77,16 +77,11 @@ impl<V: Lane> Lane for X2<V> {
     type Scalar = V::Scalar;
     type Mask = X2Mask<V::Mask>;
     type Wide = X2<Self>;
-    type Rows16 = V::Rows16;
     const LANES: usize = 2 * V::LANES;
 
     #[inline(always)]
     fn splat(x: Self::Scalar) -> Self {
         X2([V::splat(x); 2])
-    }
-    #[inline(always)]
-    fn splat2(x: Self::Scalar, y: Self::Scalar) -> Self {
-        X2([V::splat(x), V::splat(y)])
     }
     #[inline(always)]
     fn load(s: &[Self::Scalar]) -> Self {

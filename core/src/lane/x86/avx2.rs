@@ -63,7 +63,6 @@ impl Lane for F32x8 {
     type Scalar = f32;
     type Mask = M32x8;
     type Wide = crate::lane::X2<Self>;
-    type Rows16 = crate::lane::X2<Self>;
     const LANES: usize = 8;
 
     #[inline(always)]
@@ -379,7 +378,6 @@ impl Lane for F64x4 {
     type Scalar = f64;
     type Mask = M64x4;
     type Wide = crate::lane::X2<Self>;
-    type Rows16 = crate::lane::X2<crate::lane::X2<Self>>;
     const LANES: usize = 4;
 
     #[inline(always)]

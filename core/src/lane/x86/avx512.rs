@@ -203,12 +203,6 @@ macro_rules! avx512_lane {
                 Self::select(special, Self::splat(0.0), g + Self::splat(1.0))
             }
             #[inline(always)]
-            fn splat2(x: $t, y: $t) -> Self {
-                let hi = (((1u32 << $n) - 1) & !((1u32 << ($n / 2)) - 1)) as $kraw;
-                // SAFETY: see the module docs. `blend(k, a, b)` takes `b` where `k` is set.
-                unsafe { $v($blend(hi, $set1(x), $set1(y))) }
-            }
-            #[inline(always)]
             fn pow2(e: Self) -> Self {
                 // `vscalef(1, e)` = 2^⌊e⌋, exact for an integer in the normal range.
                 // SAFETY: see the module docs.
@@ -270,8 +264,6 @@ avx512_lane!(
     _mm512_getexp_ps,
     _mm512_scalef_ps,
     {
-        type Rows16 = Self;
-        const ONE_REGISTER: bool = true;
         // Records in two halves of eight lanes, each transposed as on AVX2.
         #[inline(always)]
         unsafe fn load_records(base: *const f32, rec: usize, out: &mut [Self]) {
@@ -352,7 +344,5 @@ avx512_lane!(
     _mm512_cmp_pd_mask,
     _mm512_getexp_pd,
     _mm512_scalef_pd,
-    {
-        type Rows16 = crate::lane::X2<Self>;
-    }
+    {}
 );

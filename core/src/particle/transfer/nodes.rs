@@ -109,13 +109,12 @@ pub(crate) fn nodes<T: Real, const D: usize, const K: usize, const N: usize>(
     nd
 }
 
-/// The lane indices `[0, 1, …, 7]` as scalars (a constant vector), repeated in every eight
-/// lanes of a wider `R`.
+/// The lane indices `[0, 1, …, 7]` as scalars (a constant vector).
 #[inline(always)]
 pub(crate) fn lane_index<T: Real, R: Lane<Scalar = T>>() -> R {
-    let mut l = [T::ZERO; 2 * ROW_LANES];
+    let mut l = [T::ZERO; ROW_LANES];
     for (i, x) in l.iter_mut().enumerate() {
-        *x = T::from_i32((i % ROW_LANES) as i32);
+        *x = T::from_i32(i as i32);
     }
     R::load(&l)
 }

@@ -34,14 +34,6 @@
 //! The values are those of the per-node formulas up to rounding (products and sums in
 //! another order).
 //!
-//! **Pairs.** Where a sixteen-lane vector is one register (`f32` on AVX-512), a
-//! [`PairTile`] holds two channels' eight-lane rows side by side in it, so that each of the
-//! multiply-adds above serves two channels (a channel's eight lanes go through the same
-//! operations on the same values, so the sums have the same bits as in eight-lane rows). P2G's
-//! usual channel sets (mass and momentum, then optionally heat) and the force differential's
-//! forces use it; the pairs are split into the channels' rows when the tile is added to the
-//! grid.
-//!
 //! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
 //! the old values are put back and the run's particles are added one by one by the
 //! per-particle path, which finds the particles that fail. A run's tile sum can be finite where
@@ -67,10 +59,6 @@ pub(super) const MAX_RUN: usize = 48;
 pub(super) const MAX_CH: usize = 10;
 /// Largest dimension.
 const MAX_D: usize = 3;
-/// Most channel pairs of a [`PairTile`]: mass, momentum and the three heat channels in 3D.
-pub(super) const MAX_PAIRS: usize = 4;
-/// The unused half of a [`PairTile`]'s last pair.
-pub(super) const NO_CHANNEL: usize = usize::MAX;
 
 /// The per-particle lane vectors of one channel's node values (see the module docs). A term
 /// that the channel does not have is skipped (`has_e`, `has_b` false). Plain arrays and flags
@@ -226,106 +214,6 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         }
         self.used = true;
         rt
-    }
-}
-
-/// A [`Tile`] whose rows hold two channels side by side in one sixteen-lane vector `P` (lanes
-/// `0..8` one channel's eight-lane row, lanes `8..16` another's). Where `P` is one register
-/// (`f32` on AVX-512), each multiply-add of the factored sum serves two channels. The pairs
-/// are split into the channels' rows when the tile is added to the grid, through
-/// [`Tile::add_to_grid`].
-///
-/// The first pairs take the terms `E_a` and `B_a` (as the add asks), the others `P` only. A
-/// channel without those terms can share a pair that takes them (the mass with the third
-/// momentum channel in 3D): its `E_a`, `B_a` are zero, every added term is an exact zero, and
-/// its sums have the bits of the unpaired form.
-pub(super) struct PairTile<R, P, const D: usize> {
-    /// The tile: its geometry, and the channels' rows when the pairs are split.
-    pub tile: Tile<R, D>,
-    /// Summed node values per pair and row.
-    acc: [[P; MAX_ROWS]; MAX_PAIRS],
-    /// The channels (indices into the written channels) of the low and high half of each
-    /// pair ([`NO_CHANNEL`]: none).
-    ch: [[usize; 2]; MAX_PAIRS],
-    /// Pairs in use.
-    pairs: usize,
-    /// Pairs that take the `E_a`, `B_a` terms (the first ones).
-    terms: usize,
-}
-
-impl<T: Real, R: Lane<Scalar = T>, P: Lane<Scalar = T>, const D: usize> PairTile<R, P, D> {
-    /// An empty tile whose pair `q` holds the channels `order[2q]`, `order[2q + 1]` (the last
-    /// half unused for an odd count), the first `terms` pairs with the `E_a`, `B_a` terms;
-    /// with no `order`, no pairs: only [`Self::tile`] is used.
-    #[inline(always)]
-    pub fn new(order: &[usize], terms: usize) -> Self {
-        debug_assert_eq!(P::LANES, 2 * TILE_X);
-        debug_assert!(order.len() <= 2 * MAX_PAIRS);
-        let mut ch = [[NO_CHANNEL; 2]; MAX_PAIRS];
-        for (k, &c) in order.iter().enumerate() {
-            ch[k / 2][k % 2] = c;
-        }
-        Self {
-            tile: Tile::new(),
-            acc: [[P::splat(T::ZERO); MAX_ROWS]; MAX_PAIRS],
-            ch,
-            pairs: order.len().div_ceil(2),
-            terms,
-        }
-    }
-
-    /// The channels (low half, high half; [`NO_CHANNEL`] none) of each pair, the number of
-    /// pairs, and of pairs with the `E_a`, `B_a` terms (the first ones).
-    #[inline(always)]
-    pub fn layout(&self) -> (&[[usize; 2]; MAX_PAIRS], usize, usize) {
-        (&self.ch, self.pairs, self.terms)
-    }
-
-    /// Adds the node values of one particle with stencil `st` (`K` nodes per axis) at lane
-    /// offsets `s`: pair `q` with the lane vectors `coef[q]`, which have the terms `E_a` when
-    /// `E` and `B_a` when `B` for the first pairs (see [`Self::new`]), and `P` only for the
-    /// others.
-    #[inline(always)]
-    pub fn add<const K: usize, const E: bool, const B: bool>(
-        &mut self,
-        s: &[usize; D],
-        st: &Stencil<T, D>,
-        coef: &[Coef<P, D>; MAX_PAIRS],
-    ) {
-        let rt = self.tile.mark_rows::<K>(s);
-        for (q, (acc, k)) in self.acc.iter_mut().zip(coef).enumerate().take(self.pairs) {
-            if q < self.terms {
-                add_channel::<T, P, D, K, E, B>(acc, &rt, st, k);
-            } else {
-                add_channel::<T, P, D, K, false, false>(acc, &rt, st, k);
-            }
-        }
-    }
-
-    /// Splits the pairs into the channels' rows and adds the tile to the channels `outs`, as
-    /// [`Tile::add_to_grid`] (which see, also for the safety contract).
-    #[inline(always)]
-    pub unsafe fn add_to_grid<const K: usize>(&mut self, outs: &[OutChannel<T, D>]) -> bool {
-        if !self.tile.used {
-            return true;
-        }
-        let rows = (K + 1).pow(D as u32 - 1);
-        let mut b = [T::ZERO; 2 * TILE_X];
-        for t in 0..rows {
-            if self.tile.bits[t] == 0 {
-                continue;
-            }
-            for (acc, ch) in self.acc.iter_mut().zip(&self.ch).take(self.pairs) {
-                acc[t].store(&mut b);
-                acc[t] = P::splat(T::ZERO);
-                for (h, &c) in ch.iter().enumerate() {
-                    if c != NO_CHANNEL {
-                        self.tile.acc[c][t] = R::load(&b[h * TILE_X..]);
-                    }
-                }
-            }
-        }
-        self.tile.add_to_grid::<K>(outs)
     }
 }
 
@@ -526,35 +414,4 @@ pub(super) fn set_grad<T: Real, R: Lane<Scalar = T>, const D: usize>(
     }
     c.has_e = false;
     c.has_b = true;
-}
-
-/// [`set_grad`] with `f = 1` for the two channels of a [`PairTile`] pair: lanes `0..8` with
-/// row `ch[0]` of `m`, lanes `8..16` with row `ch[1]` ([`NO_CHANNEL`]: zero).
-#[inline(always)]
-pub(super) fn set_grad_pair<T: Real, P: Lane<Scalar = T>, const D: usize>(
-    c: &mut Coef<P, D>,
-    w: P,
-    dw: P,
-    m: &Mat<T, D>,
-    ch: [usize; 2],
-) {
-    let (lo, hi) = (row_or_zero(m, ch[0]), row_or_zero(m, ch[1]));
-    c.p = dw * P::splat2(lo[0], hi[0]);
-    for b in 1..D {
-        c.b[b] = w * P::splat2(lo[b], hi[b]);
-    }
-    c.has_e = false;
-    c.has_b = true;
-}
-
-/// Row `a` of `m` (zero for [`NO_CHANNEL`]).
-#[inline(always)]
-fn row_or_zero<T: Real, const D: usize>(m: &Mat<T, D>, a: usize) -> [T; D] {
-    let mut r = [T::ZERO; D];
-    if a != NO_CHANNEL {
-        for (b, x) in r.iter_mut().enumerate() {
-            *x = m.cols[b][a];
-        }
-    }
-    r
 }

@@ -10,9 +10,7 @@ use crate::particle::implicit::{apply_entries, apply_slot, slot_len, tag};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::transfer::field_sums::node_field_sums;
 use crate::particle::transfer::nodes::{add, nodes, rel_base, restore, table, with_nodes};
-use crate::particle::transfer::tile::{
-    axis0, set_grad, set_grad_pair, Coef, PairTile, MAX_PAIRS, MAX_RUN, TILE_X,
-};
+use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use crate::particle::transfer::{chunk_stencils, rd_vec, BatchStatus, FirstFailure};
 use crate::scalar::Real;
 use core::mem::MaybeUninit;
@@ -86,8 +84,7 @@ where
 
     #[inline(always)]
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        with_nodes!(self.kernel, D, |K, N| self
-            .run_nodes::<R, V::Rows16, K, N>())
+        with_nodes!(self.kernel, D, |K, N| self.run_nodes::<R, K, N>())
     }
 }
 
@@ -105,18 +102,10 @@ where
     /// multiply-adds are fused on the vector instruction sets), then the tile (writes of
     /// `δf`, which no read of `δu` sees).
     #[inline(always)]
-    fn run_nodes<R: Lane<Scalar = T>, P: Lane<Scalar = T>, const K: usize, const N: usize>(
-        &mut self,
-    ) -> BatchStatus {
+    fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
         let mut first = FirstFailure::new(self.n);
-        // The force channels two per row vector where that is one register (see `PairTile`).
-        let order: &[usize] = match (P::ONE_REGISTER, D) {
-            (false, _) => &[],
-            (_, 2) => &[0, 1],
-            _ => &[0, 1, 2],
-        };
-        let mut tile = PairTile::<R, P, D>::new(order, MAX_PAIRS);
+        let mut tile = Tile::<R, D>::new();
         let mut run = [0usize; MAX_RUN];
         let mut nrun = 0;
         let (kernel, h) = (self.kernel, self.h);
@@ -166,7 +155,7 @@ where
                 if live[k] {
                     // SAFETY: as above.
                     unsafe {
-                        self.tile_add::<R, P, K, N>(
+                        self.tile_add::<R, K, N>(
                             start + k,
                             (&stencils[k], &rels[k], &ms[k]),
                             &mut tile,
@@ -179,7 +168,7 @@ where
             start += len;
         }
         // SAFETY: as above.
-        unsafe { self.flush::<R, P, K, N>(&mut tile, &run[..nrun], &mut first) };
+        unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &mut first) };
         first.status()
     }
 
@@ -189,44 +178,34 @@ where
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn tile_add<R: Lane<Scalar = T>, P: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
         i: usize,
         (s, rel, m): (&Stencil<T, D>, &[isize; D], &Mat<T, D>),
-        tile: &mut PairTile<R, P, D>,
+        tile: &mut Tile<R, D>,
         (run, nrun): (&mut [usize; MAX_RUN], &mut usize),
         first: &mut FirstFailure,
     ) {
         let fits = if *nrun < MAX_RUN {
-            tile.tile.place::<K>(rel, &s.fx)
+            tile.place::<K>(rel, &s.fx)
         } else {
             None
         };
         let sp = match fits {
             Some(sp) => sp,
             None => {
-                self.flush::<R, P, K, N>(tile, &run[..*nrun], first);
+                self.flush::<R, K, N>(tile, &run[..*nrun], first);
                 *nrun = 0;
                 // An empty tile takes any stencil.
-                tile.tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
+                tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
             }
         };
-        if P::ONE_REGISTER {
-            let (w, dw, _) = axis0::<T, P, D, K>(s, sp[0]);
-            let (ch, pairs, _) = tile.layout();
-            let mut coef = [Coef::only(P::splat(T::ZERO)); MAX_PAIRS];
-            for (c, &ch) in coef.iter_mut().zip(ch).take(pairs) {
-                set_grad_pair(c, w, dw, m, ch);
-            }
-            tile.add::<K, false, true>(&sp, s, &coef);
-        } else {
-            let (w, dw, _) = axis0::<T, R, D, K>(s, sp[0]);
-            let mut coef = [Coef::only(R::splat(T::ZERO)); D];
-            for (a, c) in coef.iter_mut().enumerate() {
-                set_grad(c, w, dw, m, a, T::ONE);
-            }
-            tile.tile.add_uniform::<K, false, true>(&sp, s, &coef);
+        let (w, dw, _) = axis0::<T, R, D, K>(s, sp[0]);
+        let mut coef = [Coef::only(R::splat(T::ZERO)); D];
+        for (a, c) in coef.iter_mut().enumerate() {
+            set_grad(c, w, dw, m, a, T::ONE);
         }
+        tile.add_uniform::<K, false, true>(&sp, s, &coef);
         run[*nrun] = i;
         *nrun += 1;
     }
@@ -292,9 +271,9 @@ where
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn flush<R: Lane<Scalar = T>, P: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
-        tile: &mut PairTile<R, P, D>,
+        tile: &mut Tile<R, D>,
         run: &[usize],
         first: &mut FirstFailure,
     ) {

@@ -16,9 +16,7 @@ use crate::particle::stencil::Stencil;
 use crate::particle::transfer::nodes::{
     add, node_offsets, nodes, rel_base, restore, table, with_nodes,
 };
-use crate::particle::transfer::tile::{
-    axis0, set_grad, Coef, PairTile, MAX_CH, MAX_PAIRS, MAX_RUN, NO_CHANNEL, TILE_X,
-};
+use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_CH, MAX_RUN, TILE_X};
 use crate::particle::transfer::BatchStatus;
 use crate::particle::{Dilation, Kernel};
 use core::marker::PhantomData;
@@ -188,125 +186,43 @@ where
         }
     }
 
-    /// The lane vectors of the pairs of a [`PairTile`] with channel `layout` (see
-    /// [`PairTile::layout`]), for lane offset `s0` along axis 0: for each half the lane vectors
-    /// of [`Self::channel_coef`], from the same operations on the same values (a mass paired
-    /// with a momentum channel gets exact zeros for the `E_a`, `B_a` terms).
-    #[inline(always)]
-    fn pair_coef<P: Lane<Scalar = T>, const K: usize>(
-        &self,
-        r: &Ready<'_, T, D>,
-        s0: usize,
-        (ch, pairs, terms): (&[[usize; 2]; MAX_PAIRS], usize, usize),
-    ) -> [Coef<P, D>; MAX_PAIRS] {
-        let (w, dw, o0) = axis0::<T, P, D, K>(r.s, s0);
-        let mut out = [Coef::only(P::splat(T::ZERO)); MAX_PAIRS];
-        let idt = self.args.impulse_dt;
-        for (q, c) in out.iter_mut().enumerate().take(pairs) {
-            let (lo, hi) = (
-                self.pair_scalars(r, ch[q][0]),
-                self.pair_scalars(r, ch[q][1]),
-            );
-            if q >= terms {
-                *c = Coef::only(w * P::splat2(lo.0, hi.0));
-                continue;
-            }
-            // As `channel_coef` for a momentum channel, the mass's `q₀` being its mass.
-            let qv = P::splat2(lo.1[0], hi.1[0]).mul_add(o0, P::splat2(lo.0, hi.0));
-            if idt == T::ZERO {
-                c.p = w * qv;
-                c.has_b = false;
-            } else {
-                c.p = dw * P::splat2(lo.2[0], hi.2[0]);
-                for b in 1..D {
-                    c.b[b] = w * P::splat2(lo.2[b], hi.2[b]);
-                }
-                c.has_b = true;
-                c.p = w.mul_add(qv, c.p);
-            }
-            for b in 1..D {
-                c.e[b] = w * P::splat2(lo.1[b], hi.1[b]);
-            }
-            c.has_e = true;
-        }
-        out
-    }
-
-    /// The per-particle scalars of written channel `c` for [`Self::pair_coef`]: the factor of
-    /// `w` (`q₀ₐ` for momentum along `a`, the mass, the heat value), row `a` of `m C h` and
-    /// row `a` of `Δt_f fm` (zero for the channels without these terms and for
-    /// [`NO_CHANNEL`]).
-    #[inline(always)]
-    fn pair_scalars(&self, r: &Ready<'_, T, D>, c: usize) -> (T, [T; D], [T; D]) {
-        let (mut e, mut f) = ([T::ZERO; D], [T::ZERO; D]);
-        if c == NO_CHANNEL {
-            return (T::ZERO, e, f);
-        }
-        let p = match self.kinds[c] {
-            0 => r.mass,
-            k @ 1..=3 => {
-                let a = k - 1;
-                for b in 0..D {
-                    e[b] = r.mch.cols[b][a];
-                    f[b] = self.args.impulse_dt * r.fm.cols[b][a];
-                }
-                r.q0[a]
-            }
-            k => r.heat[k - 7],
-        };
-        (p, e, f)
-    }
-
     /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
     /// particle does not fit in its tile or the run is full.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn tile_add<
-        R: Lane<Scalar = T>,
-        P: Lane<Scalar = T>,
-        const K: usize,
-        const N: usize,
-        const SET: u8,
-    >(
+    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize, const SET: u8>(
         &mut self,
         i: usize,
         r: &Ready<'_, T, D>,
         tau_dev: Mat<T, D>,
-        tile: &mut PairTile<R, P, D>,
+        tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) -> Result<()> {
         let rel = rel_base(r.s, &self.view.nodes)?;
         if run.n == MAX_RUN {
-            self.flush::<R, P, K, N>(tile, run, oc);
+            self.flush::<R, K, N>(tile, run, oc);
         }
         let s = loop {
-            if let Some(s) = tile.tile.place::<K>(&rel, &r.s.fx) {
+            if let Some(s) = tile.place::<K>(&rel, &r.s.fx) {
                 break s;
             }
             // An empty tile takes any stencil.
-            self.flush::<R, P, K, N>(tile, run, oc);
+            self.flush::<R, K, N>(tile, run, oc);
         };
         let idt = self.args.impulse_dt;
         if SET == ANY_CHANNELS {
             self.set_coef::<R, K>(r, s[0], coef);
-            tile.tile.add::<K>(&s, r.s, &coef[..self.na]);
-        } else if P::ONE_REGISTER {
-            let c = self.pair_coef::<P, K>(r, s[0], tile.layout());
-            if idt == T::ZERO {
-                tile.add::<K, true, false>(&s, r.s, &c);
-            } else {
-                tile.add::<K, true, true>(&s, r.s, &c);
-            }
+            tile.add::<K>(&s, r.s, &coef[..self.na]);
         } else {
             // A constant in each loop (`SET`), so the heat terms fold away or stay.
             let heat = SET == WITH_HEAT;
             let c = self.fixed_coef::<R, K>(r, s[0], heat);
             if idt == T::ZERO {
-                tile.tile.add_fixed::<K, false>(&s, r.s, &c, heat);
+                tile.add_fixed::<K, false>(&s, r.s, &c, heat);
             } else {
-                tile.tile.add_fixed::<K, true>(&s, r.s, &c, heat);
+                tile.add_fixed::<K, true>(&s, r.s, &c, heat);
             }
         }
         run.idx[run.n] = i;
@@ -319,9 +235,9 @@ where
     /// is left as it was and the run's particles are added one by one ([`Self::scatter`]),
     /// which refuses the ones that overflow.
     #[inline(always)]
-    unsafe fn flush<R: Lane<Scalar = T>, P: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &mut self,
-        tile: &mut PairTile<R, P, D>,
+        tile: &mut Tile<R, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
     ) {
@@ -362,14 +278,13 @@ where
         const N: usize,
         const SET: u8,
         const L: usize,
-        P: Lane<Scalar = T>,
     >(
         &mut self,
         i: usize,
         (pre, from_lanes, x): Source<'_, T, D, L>,
         tau_dev: Mat<T, D>,
         lane_stencil: Option<&Stencil<T, D>>,
-        (tile, run): (&mut PairTile<R, P, D>, &mut Run<T, D>),
+        (tile, run): (&mut Tile<R, D>, &mut Run<T, D>),
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) {
@@ -391,7 +306,7 @@ where
         };
         let r = match ready {
             Err(e) => Err(e),
-            Ok(r) => self.tile_add::<R, P, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
+            Ok(r) => self.tile_add::<R, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
         };
         self.first.note(i, r);
     }
@@ -485,18 +400,7 @@ where
         debug_assert_eq!(R::LANES, TILE_X);
         debug_assert!(V::LANES <= L);
         let oc = node_offsets::<T, D, K, N>();
-        // Two channels per row vector where that is one register (see `PairTile`).
-        // The momentum channels first, two per pair; in 3D the third shares its pair with the
-        // mass; the mass (2D) and the heat channels fill the other pairs.
-        let packed = SET != ANY_CHANNELS && <V::Rows16 as Lane>::ONE_REGISTER;
-        let order: &[usize] = match (packed, D, SET == WITH_HEAT) {
-            (false, ..) => &[],
-            (_, 2, false) => &[1, 2, 0],
-            (_, 2, true) => &[1, 2, 0, 3, 4, 5],
-            (_, _, false) => &[1, 2, 3, 0],
-            (_, _, true) => &[1, 2, 3, 0, 4, 5, 6],
-        };
-        let mut tile = PairTile::<R, V::Rows16, D>::new(order, D.div_ceil(2));
+        let mut tile = Tile::<R, D>::new();
         // The tile lane vectors of the particle being added (filled per particle for the
         // active channels; one buffer, so that no per-particle array is initialised).
         let mut coef = [Coef::only(R::splat(T::ZERO)); MAX_CH];
@@ -610,7 +514,7 @@ where
                     let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
-                        self.finish::<R, K, N, SET, L, V::Rows16>(
+                        self.finish::<R, K, N, SET, L>(
                             start + l,
                             (&pres[l], from_lanes, &xs[l]),
                             tau,
@@ -625,7 +529,7 @@ where
             start += len;
         }
         // SAFETY: as above.
-        unsafe { self.flush::<R, V::Rows16, K, N>(&mut tile, &mut run, &oc) };
+        unsafe { self.flush::<R, K, N>(&mut tile, &mut run, &oc) };
         self.first.status()
     }
 }
