@@ -514,9 +514,9 @@ where
         };
         ps.sort_by_key(cell);
         let heat = mat.heat.is_some();
+        // Mass and momentum, then the heat channels when the material has heat.
         let written: Vec<usize> = (0..CH)
-            .filter(|&c| c < FORCE || (heat && c >= HC))
-            .filter(|&c| c < MOM + D || c >= FORCE)
+            .filter(|&c| c < MOM + D || (heat && c >= HC))
             .collect();
         for idt in [0.0, 1e-4] {
             let args = P2gArgs {
