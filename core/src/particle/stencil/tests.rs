@@ -3,7 +3,7 @@
 //! bit, on every lane type the CPU has.
 
 use super::{Grid, Kernel, Stencil, MAX_CELLS};
-use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp};
+use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp, WIDE_LANES};
 use crate::lane::{Isa, Lane};
 use crate::scalar::Real;
 use std::vec::Vec;
@@ -22,8 +22,8 @@ fn bits<T: Real, const D: usize>(s: &Stencil<T, D>) -> Vec<u64> {
     v
 }
 
-/// Runs `new_lanes` on the kernel lanes `V` and the row lanes `R` of an instruction set and
-/// compares every lane with `Stencil::new`.
+/// Runs `new_lanes` on the kernel lanes `V`, their wide form `V::Wide` and the row lanes `R` of
+/// an instruction set and compares every lane with `Stencil::new`.
 struct Check<'a, T, const D: usize> {
     kernel: Kernel,
     grid: Grid,
@@ -37,10 +37,10 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
     fn lanes<V: Lane<Scalar = T>>(&mut self) {
         let n = V::LANES;
         for chunk in self.xs.chunks(n) {
-            let mut xs = [[T::ZERO; D]; 32];
+            let mut xs = [[T::ZERO; D]; WIDE_LANES];
             xs[..chunk.len()].copy_from_slice(chunk);
             // Placeholders with values that a lane must overwrite.
-            let mut out = [Stencil::blank(Kernel::Cubic, T::from_i32(7)); 32];
+            let mut out = [Stencil::blank(Kernel::Cubic, T::from_i32(7)); WIDE_LANES];
             for s in out.iter_mut() {
                 s.w = [[T::from_i32(9); 4]; D];
                 s.base = [-5; D];
@@ -66,6 +66,8 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
 impl<T: Real, const D: usize> LaneOp<T> for Check<'_, T, D> {
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
         self.lanes::<V>();
+        // P2G's chunks in `f32` (see `BatchReal::with_chunks`).
+        self.lanes::<V::Wide>();
         BatchStatus {
             first_failed: 0,
             error: None,
