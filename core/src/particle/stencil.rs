@@ -274,10 +274,11 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         let first = out.as_mut_ptr();
         // The positions per axis: on `f32` chunks wider than eight lanes, the records
         // transposed in registers ([`Lane::load_records`]); otherwise copied through `xa`.
-        // The copy's scalar stores cannot forward to the wide load that follows it: P2G's
-        // 32-lane chunks on AVX-512 measured 6–9 ns per particle faster with the record loads
-        // (Intel Xeon, 3D f32), while the eight-lane chunks of G2P and apply measured 2–3 ns
-        // slower with them, and `f64` record loads are gathers.
+        // The copy's scalar stores cannot forward to the wide load that follows it. On an
+        // Intel Xeon (3D f32), P2G's wide chunks on AVX-512 measured faster with the record
+        // loads in `transfer_timing` (elastic 95–98 against 104 ns, fluid 64–67 against 69)
+        // and within the noise in `bench_transfers` (README); the eight-lane chunks of G2P and
+        // apply measured 2–3 ns slower with them; `f64` record loads are gathers.
         let mut xv = [zero; 3];
         let records = size_of::<T>() == 4 && n > 8;
         if records {
