@@ -273,17 +273,15 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         debug_assert_eq!(size_of::<Self>() % size_of::<T>(), 0);
         let first = out.as_mut_ptr();
         // The positions per axis: on `f32` chunks wider than eight lanes, the records
-        // transposed in registers ([`Lane::load_records`]); otherwise copied through `xa`.
-        // The copy's scalar stores cannot forward to the wide load that follows it. On an
-        // Intel Xeon (3D f32), P2G's wide chunks on AVX-512 measured faster with the record
-        // loads in `transfer_timing` (elastic 95–98 against 104 ns, fluid 64–67 against 69)
-        // and within the noise in `bench_transfers` (README); the eight-lane chunks of G2P and
-        // apply measured 2–3 ns slower with them; `f64` record loads are gathers.
-        let mut xv = [zero; 3];
+        // transposed in registers ([`Lane::load_records`]), since the copy's scalar stores
+        // cannot forward to the wide load that follows them; otherwise copied through `xa`
+        // (faster on eight lanes; `f64` record loads are gathers). Measurements: README,
+        // "MPM particle updates", the paragraph on what still limits the transfers.
+        let mut xv = [zero; D];
         let records = size_of::<T>() == 4 && n > 8;
         if records {
             // SAFETY: `xs` holds `n = LANES` contiguous records of `D` scalars.
-            unsafe { V::load_records(xs.as_ptr().cast::<T>(), D, &mut xv[..D]) };
+            unsafe { V::load_records(xs.as_ptr().cast::<T>(), D, &mut xv) };
         }
         for a in 0..D {
             if !records {
