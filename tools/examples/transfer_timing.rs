@@ -1,7 +1,9 @@
 //! Quick split timing of P2G, G2P and the force differential's apply (f32 quadratic, 3D, or 2D
 //! with `AMPM_TT_DIM=2`): `cargo run --release -p ampm-tools --example transfer_timing --
 //! <fluid|elastic|thermal>` (a development aid; the benchmarks are `c_tests/bench_transfers`
-//! and `tools/benches/particle_levels.rs`).
+//! and `tools/benches/particle_levels.rs`). Environment: `AMPM_TT_REPS` (runs, best kept),
+//! `AMPM_TT_ISA` (`avx2`, `avx512`, ...: that instruction set only), `AMPM_TT_SIDE` (particles
+//! per axis), `AMPM_TT_PAD` (more grid nodes per axis).
 use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
 use ampm_core::particle::transfer::force::{self, ForceView};
@@ -54,7 +56,12 @@ where
     // 273.15 K).
     let thermal = level == "thermal";
     // 54,872 particles in 3D, 262,144 in 2D.
-    let s = if D == 3 { 38usize } else { 512 };
+    // `AMPM_TT_SIDE`: particles per axis instead (an even number; a small side keeps the
+    // particle arrays in cache, which separates memory traffic from the arithmetic).
+    let s = std::env::var("AMPM_TT_SIDE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(if D == 3 { 38usize } else { 512 });
     let n = s.pow(D as u32);
     let h = 0.02f32;
     // A lattice at spacing h/2, shuffled and then sorted by cell (x fastest), as a host and
@@ -132,7 +139,12 @@ where
         }),
         ..Material::default()
     };
-    let dims = [(s / 2 + 8) as i32; D];
+    // `AMPM_TT_PAD`: that many more nodes per axis (a larger grid for the same particles).
+    let pad: usize = std::env::var("AMPM_TT_PAD")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let dims = [(s / 2 + 8 + pad) as i32; D];
     let nn: usize = dims.iter().map(|&d| d as usize).product();
     let mut stride = [1isize; D];
     for a in 1..D {
