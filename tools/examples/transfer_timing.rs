@@ -35,6 +35,14 @@ impl Cpu {
     }
 }
 
+/// The environment variable `name` as a count, `default` when unset or not a count.
+fn env_usize(name: &str, default: usize) -> usize {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
 fn main() {
     match std::env::var("AMPM_TT_DIM").as_deref() {
         Ok("2") => run::<2>(),
@@ -56,12 +64,9 @@ where
     // 273.15 K).
     let thermal = level == "thermal";
     // 54,872 particles in 3D, 262,144 in 2D.
-    // `AMPM_TT_SIDE`: particles per axis instead (an even number; a small side keeps the
-    // particle arrays in cache, which separates memory traffic from the arithmetic).
-    let s = std::env::var("AMPM_TT_SIDE")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(if D == 3 { 38usize } else { 512 });
+    // `AMPM_TT_SIDE`: particles per axis instead (a small side keeps the particles and the
+    // grid in the cache).
+    let s = env_usize("AMPM_TT_SIDE", if D == 3 { 38 } else { 512 });
     let n = s.pow(D as u32);
     let h = 0.02f32;
     // A lattice at spacing h/2, shuffled and then sorted by cell (x fastest), as a host and
@@ -140,10 +145,7 @@ where
         ..Material::default()
     };
     // `AMPM_TT_PAD`: that many more nodes per axis (a larger grid for the same particles).
-    let pad: usize = std::env::var("AMPM_TT_PAD")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(0);
+    let pad = env_usize("AMPM_TT_PAD", 0);
     let dims = [(s / 2 + 8 + pad) as i32; D];
     let nn: usize = dims.iter().map(|&d| d as usize).product();
     let mut stride = [1isize; D];
@@ -191,10 +193,7 @@ where
             h,
             impulse_dt: 1e-4,
         };
-        let reps: usize = std::env::var("AMPM_TT_REPS")
-            .ok()
-            .and_then(|r| r.parse().ok())
-            .unwrap_or(10);
+        let reps = env_usize("AMPM_TT_REPS", 10);
         let mut best = (f64::MAX, f64::MAX, f64::MAX);
         // The force differential, prepared once from the initial state.
         let mut slots = vec![0.0f32; n * slot_len(D)];
