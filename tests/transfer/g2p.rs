@@ -155,10 +155,12 @@ where
 /// The batch mixes chunks that stay on lanes (one with a particle of the other phase among
 /// them) with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
 /// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node
-/// velocity), and one whose `F_E` has a subnormal column (the liquid projection's scalings
-/// leave the normal range). Liquid batches also have isotropic and general `F_P` and an `F_E`
-/// with columns of very different scales (the projection's root on equilibrated columns), in
-/// chunks that stay on lanes.
+/// velocity), and one whose `F_E` has a subnormal column. A liquid's `F_E` is `s I` (the state
+/// every liquid step leaves, whose new `F_E` comes from `det(I + Δt∇v)` on the lanes), with
+/// `s` over a wide range, and its `F_P` isotropic or general, in chunks that stay on lanes;
+/// liquid batches also have chunks with a liquid of general `F_E` (a solid that has just
+/// melted, which the lanes leave to the scalar step), one with columns of very different
+/// scales (the projection's root on equilibrated columns).
 fn g2p_chunks_match_single<T: BatchReal, const D: usize>()
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -182,6 +184,13 @@ where
             };
             for (i, p) in ps.iter_mut().enumerate() {
                 p.phase = this;
+                if liquid && !matches!(i, 44 | 60 | 70) {
+                    // J_E^{1/d} from 2^{∓bias/4} to 2^{±bias/4}, mostly near 1.
+                    let e = if i % 5 == 0 { T::MAX_EXP / 4 } else { 0 };
+                    let s =
+                        T::from_f64(rng.random_range(0.9..1.1)).scalbn(e * (i % 2 * 2) as i32 - e);
+                    p.f_e = Mat::identity() * s;
+                }
                 if liquid && i % 3 == 1 {
                     p.f_p = Mat::identity() * T::from_f64(rng.random_range(0.8..1.25));
                 } else if liquid && i % 3 == 2 {

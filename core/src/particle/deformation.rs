@@ -205,7 +205,17 @@ pub fn liquid_projection<T: Real, const D: usize>(
 where
     Mat<T, D>: Matrix<Scalar = T>,
 {
-    let fe = Mat::<T, D>::from_diagonal([root_det(f_e)?; D]);
+    projected(root_det(f_e)?, f_p)
+}
+
+/// `(r I, F_P')` with `F_P' = f_p` where `f_p = s I`, `s > 0`, else `J_P^{1/d} I`, both
+/// checked ([`check_det`]): the projection once `J_E^{1/d} = r` is known.
+#[inline]
+fn projected<T: Real, const D: usize>(r: T, f_p: &Mat<T, D>) -> Result<(Mat<T, D>, Mat<T, D>)>
+where
+    Mat<T, D>: Matrix<Scalar = T>,
+{
+    let fe = Mat::<T, D>::from_diagonal([r; D]);
     let fp = match isotropic_scale(f_p) {
         Some(s) if s > T::ZERO => *f_p,
         _ => Mat::<T, D>::from_diagonal([root_det(f_p)?; D]),
@@ -213,6 +223,45 @@ where
     check_det(&fe)?;
     check_det(&fp)?;
     Ok((fe, fp))
+}
+
+/// One liquid step: `F_E ← A F_E` with the increment `a` of [`increment`], then the projection
+/// of [`liquid_projection`]. For `f_e = s I` (`s > 0`: every liquid's `F_E` after a step) the
+/// product is not formed: `J_E ← det(A) J_E` (the module docs), so the new `F_E` is
+/// `s (det A)^{1/d} I`, the root taken of the computed `det A` when that is a normal number
+/// and on equilibrated columns ([`root_det`] of `A`) otherwise. Any other `f_e` (a solid that
+/// has just melted) is multiplied out and checked ([`check_det`]) first, then projected.
+///
+/// Errors: those of [`liquid_projection`]; for a general `f_e`, those of [`check_det`] for
+/// `A F_E`; [`Error::Overflow`] when `s (det A)^{1/d}` is not a positive finite number.
+#[inline]
+pub fn liquid_step<T: Real, const D: usize>(
+    f_e: &Mat<T, D>,
+    a: &Mat<T, D>,
+    f_p: &Mat<T, D>,
+) -> Result<(Mat<T, D>, Mat<T, D>)>
+where
+    Mat<T, D>: Matrix<Scalar = T>,
+{
+    let s = match isotropic_scale(f_e) {
+        Some(s) if s > T::ZERO => s,
+        _ => {
+            let f = *a * *f_e;
+            check_det(&f)?;
+            return liquid_projection(&f, f_p);
+        }
+    };
+    let det_a = Matrix::det(a);
+    let rho = if det_a.is_finite() && det_a >= T::MIN_POSITIVE {
+        root_d::<T, D>(det_a)
+    } else {
+        root_det(a)?
+    };
+    let r = s * rho;
+    if !(r.is_finite() && r > T::ZERO) {
+        return Err(Error::Overflow);
+    }
+    projected(r, f_p)
 }
 
 /// `Some(s)` when `m = s I` exactly (every off-diagonal entry 0, equal diagonal entries).
@@ -397,6 +446,38 @@ mod tests {
             assert_eq!(a, fe);
             fe = a;
         }
+    }
+
+    #[test]
+    fn liquid_step_takes_the_root_of_det_a() {
+        let a = Mat::<f64, 3>::from_rows([
+            [1.01, 0.003, -0.002],
+            [0.001, 0.985, 0.004],
+            [-0.003, 0.002, 1.02],
+        ]);
+        let fp = Mat::<f64, 3>::from_rows([[1.1, 0.2, 0.05], [-0.1, 0.9, 0.1], [0.03, 0.07, 1.05]]);
+        let s = 0.97;
+        let fe = Mat::<f64, 3>::from_diagonal([s; 3]);
+        let (fe2, fp2) = liquid_step(&fe, &a, &fp).unwrap();
+        // The isotropic branch: s (det A)^{1/3}, the F_P projection unchanged.
+        assert_eq!(fe2, Mat::from_diagonal([s * Matrix::det(&a).cbrt(); 3]));
+        assert_eq!(fp2, liquid_projection(&fe, &fp).unwrap().1);
+        // The projection of the product A F_E agrees to the rounding of the product, its
+        // determinant and the roots (a few ε each): 16ε.
+        let (fe3, _) = liquid_projection(&(a * fe), &fp).unwrap();
+        assert!((fe2.cols[0][0] / fe3.cols[0][0] - 1.0).abs() <= 16.0 * f64::EPSILON);
+        // A general F_E (a solid that has just melted) is multiplied out, as before.
+        let g = Mat::<f64, 3>::from_rows([[1.2, 0.3, 0.0], [0.1, 0.9, 0.2], [0.0, -0.1, 1.1]]);
+        assert_eq!(liquid_step(&g, &a, &fp), liquid_projection(&(a * g), &fp));
+        // det A subnormal (2^-135 in f32): the root on equilibrated columns, exact here.
+        let a = diag::<f32, 3>([-64, -64, -7]);
+        let fe = Mat::<f32, 3>::from_diagonal([2f32.powi(20); 3]);
+        let (fe2, _) = liquid_step(&fe, &a, &fe).unwrap();
+        assert_eq!(fe2, Mat::from_diagonal([2f32.powi(-25); 3]));
+        // s (det A)^{1/d} overflowing is refused.
+        let fe = Mat::<f32, 2>::from_diagonal([2f32.powi(100); 2]);
+        let a = diag::<f32, 2>([60, 60]);
+        assert_eq!(liquid_step(&fe, &a, &fe), Err(Error::Overflow));
     }
 
     #[test]

@@ -26,7 +26,7 @@
 //! step refuses.
 
 use super::apic::{self, gather};
-use super::deformation::{check_det, evolve_det, liquid_projection, snow_plasticity};
+use super::deformation::{check_det, increment, liquid_step, snow_plasticity};
 use super::dilation;
 use super::stencil::{Grid, Kernel, Stencil};
 use super::thermal::{self, HeatSplit, ThermalState};
@@ -388,8 +388,9 @@ fn check_temperature<T: Real, const D: usize>(
 ///    the phase ([`thermal::absorb`]);
 /// 2. APIC: `v_p ← s.v`, `C_p ← s.affine`, `x_p ← x_p + Δt v_p`;
 /// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`](super::deformation::evolve));
-/// 4. a liquid keeps its volume ratios only ([`liquid_projection`]: `F_E ← J_E^{1/d} I`,
-///    `F_P ← J_P^{1/d} I`); a solid with snow plasticity clamps ([`snow_plasticity`]); an
+/// 4. a liquid keeps its volume ratios only ([`liquid_step`]: `F_E ← J_E^{1/d} I`,
+///    `F_P ← J_P^{1/d} I`, for an isotropic `F_E` from `det(I + Δt∇v)` without the product
+///    of step 3); a solid with snow plasticity clamps ([`snow_plasticity`]); an
 ///    elastic solid does neither.
 ///
 /// The phase of step 4 is the one after step 1 (a solid that melts is projected at once).
@@ -485,21 +486,27 @@ where
         }
     }
 
-    // 3. Elastic deformation gradient, with the remedy.
-    let (f_e, k, j_e) = evolve_det(&p.f_e, &s.grad_v, dt)?;
+    // 3. and 4. Elastic deformation gradient with the remedy, then the liquid projection
+    // (a liquid's `F_E = s I` takes `det A` only) or plasticity. A kept `F_P` keeps its
+    // checked `J_P`.
+    let (a, k) = increment(&s.grad_v, dt)?;
     info.halvings = k;
-
-    // 4. Liquid projection or plasticity. A kept `F_P` keeps its checked `J_P`.
     let (f_e, f_p, kept) = match (out.phase, &material.plasticity) {
         (Phase::Liquid, _) => {
-            let (fe, fp) = liquid_projection(&f_e, &p.f_p)?;
+            let (fe, fp) = liquid_step(&p.f_e, &a, &p.f_p)?;
             (fe, fp, None)
         }
-        (Phase::Solid, Some(snow)) => {
-            let (fe, fp) = snow_plasticity(snow, &f_e, &p.f_p)?;
-            (fe, fp, None)
+        (Phase::Solid, plasticity) => {
+            let f_e = a * p.f_e;
+            let j_e = check_det(&f_e)?;
+            match plasticity {
+                Some(snow) => {
+                    let (fe, fp) = snow_plasticity(snow, &f_e, &p.f_p)?;
+                    (fe, fp, None)
+                }
+                None => (f_e, p.f_p, Some((j_e, j_p))),
+            }
         }
-        (Phase::Solid, None) => (f_e, p.f_p, Some((j_e, j_p))),
     };
     out.f_e = f_e;
     out.f_p = f_p;

@@ -4,22 +4,23 @@
 //!
 //! The update is that of [`crate::particle::update::update_particle`] for these particles
 //! (Stomakhin et al. 2014, §5: APIC velocity and affine matrix, `x ← x + Δt v`,
-//! `F_E ← (I + Δt∇v) F_E`; a solid keeps `F_P`, a liquid is projected to its volume ratios by
-//! [`liquid_projection`]), with the same operations in the same order (separate
-//! multiplications and additions, no fused multiply-add, the matrix products and determinants of
-//! [`crate::mat::Mat`], the power-of-two scalings and roots of [`root_det`]), so every lane gets
-//! the bits of the scalar update. With heat, the heat step (temperature, latent buffer, phase)
+//! `F_E ← (I + Δt∇v) F_E`; a solid keeps `F_P`, a liquid's isotropic `F_E` takes the root of
+//! `det(I + Δt∇v)` and its `F_P` is projected to its volume ratio by [`liquid_step`]), with the
+//! same operations in the same order (separate multiplications and additions, no fused
+//! multiply-add, the matrix products and determinants of [`crate::mat::Mat`], the power-of-two
+//! scalings and roots of [`root_det`]), so every lane gets the bits of the scalar update. With heat, the heat step (temperature, latent buffer, phase)
 //! is made on the lanes when every lane stays in its segment of the latent-heat model, else by
 //! the scalar [`thermal::step`] per lane ([`heat`]). Every check of the scalar path is made on
 //! all lanes (the input particle as [`check_particle`] checks it, the new position,
 //! `det(I + Δt∇v) > 0`, the new `F_E` and `F_P` and their determinants, the position limit);
-//! if any lane fails one, needs the remedy for `det(I + Δt∇v) ≤ 0`, or lies where
-//! [`root_det`]'s scalings leave the normal range, nothing is written and the caller
+//! if any lane fails one, needs the remedy for `det(I + Δt∇v) ≤ 0`, lies where
+//! [`root_det`]'s scalings leave the normal range, or is a liquid whose `F_E` is not isotropic
+//! (a solid that has just melted) or whose `det(I + Δt∇v)` is not normal, nothing is written and the caller
 //! updates the chunk's particles one by one, which gives each its exact status.
 //!
 //! [`check_particle`]: crate::particle::update::check_particle
 //! [`thermal::step`]: crate::particle::thermal::step
-//! [`liquid_projection`]: crate::particle::deformation::liquid_projection
+//! [`liquid_step`]: crate::particle::deformation::liquid_step
 //! [`root_det`]: crate::particle::deformation::root_det
 
 mod heat;
@@ -267,32 +268,30 @@ fn det_ok<V: Lane, const D: usize>(m: &LMat<V, D>) -> V::Mask {
     lmat::all_finite(m) & j.is_finite() & V::splat(V::Scalar::ZERO).lt(j)
 }
 
-/// [`liquid_projection`] per lane: `(J_E^{1/d} I, F_P')` with `F_P' = F_P` where `F_P = s I`,
-/// `s > 0` exactly or where `liq` is false (a solid keeps its `F_P`), else `J_P^{1/d} I`
-/// (`None`: `F_P` kept on every lane), and the lanes where both are the scalar results and
-/// pass [`check_det`] (`F_P`'s own determinant is checked by the caller).
+/// [`liquid_step`] per lane for `F_E = s I`: `(s (det A)^{1/d} I, F_P')` from `det A` (`det_a`,
+/// the increment's computed determinant) with `F_P' = F_P` where `F_P = s I`, `s > 0` exactly
+/// or where `liq` is false (a solid keeps its `F_P`), else `J_P^{1/d} I` (`None`: `F_P` kept on
+/// every lane), and the lanes where both are the scalar results and pass [`check_det`]
+/// (`F_P`'s own determinant is checked by the caller). A liquid lane whose `F_E` is not
+/// isotropic (a solid that has just melted) or whose `det A` is not a normal number is not
+/// among them: the scalar step multiplies out or equilibrates there.
 ///
-/// [`liquid_projection`]: crate::particle::deformation::liquid_projection
+/// [`liquid_step`]: crate::particle::deformation::liquid_step
 /// [`check_det`]: crate::particle::deformation::check_det
 #[inline(always)]
 fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
     f_e: &LMat<V, D>,
+    det_a: V,
     f_p: &LMat<V, D>,
     liq: V::Mask,
 ) -> (LMat<V, D>, Option<LMat<V, D>>, V::Mask) {
     let zero = V::splat(T::ZERO);
-    let (r_e, ok_e) = root_det(f_e);
-    let fe = diagonal::<V, D>(r_e);
-    let mut ok = ok_e & det_ok(&fe);
-    // As `isotropic_scale`: off-diagonal entries 0, diagonal entries equal to `f_p[0][0] > 0`.
-    let s = f_p[0][0];
-    let mut iso = zero.lt(s);
-    for (j, c) in f_p.iter().enumerate() {
-        for (i, x) in c.iter().enumerate() {
-            iso = iso & x.eq(if i == j { s } else { zero });
-        }
-    }
-    let keep = iso | !liq;
+    let root = if D == 2 { det_a.sqrt() } else { det_a.cbrt() };
+    let r = f_e[0][0] * root;
+    let fe = diagonal::<V, D>(r);
+    let normal = V::splat(T::MIN_POSITIVE).le(det_a) & det_a.is_finite();
+    let mut ok = isotropic_mask(f_e) & normal & r.is_finite() & zero.lt(r) & det_ok(&fe);
+    let keep = isotropic_mask(f_p) | !liq;
     if V::all(keep) {
         return (fe, None, ok);
     }
@@ -305,6 +304,23 @@ fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
     }
     ok = ok & (keep | (ok_p & det_ok(&fp)));
     (fe, Some(fp), ok)
+}
+
+/// The lanes where `m = s I` with `s > 0` exactly, as [`isotropic_scale`] and a positive
+/// scale: off-diagonal entries 0, diagonal entries equal to `m[0][0] > 0`.
+///
+/// [`isotropic_scale`]: crate::particle::deformation::isotropic_scale
+#[inline(always)]
+fn isotropic_mask<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> V::Mask {
+    let zero = V::splat(T::ZERO);
+    let s = m[0][0];
+    let mut iso = zero.lt(s);
+    for (j, c) in m.iter().enumerate() {
+        for (i, x) in c.iter().enumerate() {
+            iso = iso & x.eq(if i == j { s } else { zero });
+        }
+    }
+    iso
 }
 
 /// Updates particles `start..start + LANES` from their transposed samples `cs` (each sample
@@ -417,20 +433,28 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             *x = V::splat(if i == j { T::ONE } else { T::ZERO }) + *x;
         }
     }
-    ok = ok & zero.lt(lmat::det(&inc));
-    // F_E ← A F_E, finite with a finite positive determinant (`check_det`).
-    let f = product(&inc, &f_e);
-    ok = ok & det_ok(&f);
-    // A liquid keeps its volume ratios only; a solid (no plasticity) keeps `F_P`. In a chunk
-    // of both, every lane computes both and takes its own (the other's checks do not apply).
+    let det_a = lmat::det(&inc);
+    ok = ok & zero.lt(det_a);
+    // A solid (no plasticity): F_E ← A F_E, finite with a finite positive determinant
+    // (`check_det`), and it keeps `F_P`. A liquid keeps its volume ratios only, from `det A`
+    // (`liquid_step`). In a chunk of both, every lane computes both and takes its own (the
+    // other's checks do not apply).
     let (f, f_p_new) = if any_liquid {
         let liq = zero.lt(V::load(&liquid_flags));
         // The solid lanes' `F_P` is selected inside `liquid`, not by `Option::map` here: a
         // closure is not compiled with the caller's target features.
-        let (fe, fp, proj_ok) = liquid(&f, &f_p, liq);
+        let (fe, fp, proj_ok) = liquid(&f_e, det_a, &f_p, liq);
         ok = ok & (proj_ok | !liq);
-        (select_mat(liq, &fe, &f), fp)
+        if V::all(liq) {
+            (fe, fp)
+        } else {
+            let f = product(&inc, &f_e);
+            ok = ok & (det_ok(&f) | liq);
+            (select_mat(liq, &fe, &f), fp)
+        }
     } else {
+        let f = product(&inc, &f_e);
+        ok = ok & det_ok(&f);
         (f, None)
     };
     if !V::all(ok) {
