@@ -8,15 +8,16 @@
 //! `det(I + Δt∇v)` and its `F_P` is projected to its volume ratio by [`liquid_step`]), with the
 //! same operations in the same order (separate multiplications and additions, no fused
 //! multiply-add, the matrix products and determinants of [`crate::mat::Mat`], the power-of-two
-//! scalings and roots of [`root_det`]), so every lane gets the bits of the scalar update. With heat, the heat step (temperature, latent buffer, phase)
-//! is made on the lanes when every lane stays in its segment of the latent-heat model, else by
-//! the scalar [`thermal::step`] per lane ([`heat`]). Every check of the scalar path is made on
-//! all lanes (the input particle as [`check_particle`] checks it, the new position,
-//! `det(I + Δt∇v) > 0`, the new `F_E` and `F_P` and their determinants, the position limit);
-//! if any lane fails one, needs the remedy for `det(I + Δt∇v) ≤ 0`, lies where
-//! [`root_det`]'s scalings leave the normal range, or is a liquid whose `F_E` is not isotropic
-//! (a solid that has just melted) or whose `det(I + Δt∇v)` is not normal, nothing is written and the caller
-//! updates the chunk's particles one by one, which gives each its exact status.
+//! scalings and roots of [`root_det`]), so every lane gets the bits of the scalar update. With
+//! heat, the heat step (temperature, latent buffer, phase) is made on the lanes when every lane
+//! stays in its segment of the latent-heat model, else by the scalar [`thermal::step`] per lane
+//! ([`heat`]). Every check of the scalar path is made on all lanes (the input particle as
+//! [`check_particle`] checks it, the new position, `det(I + Δt∇v) > 0`, the new `F_E` and `F_P`
+//! and their determinants, the position limit); if any lane fails one, needs the remedy for
+//! `det(I + Δt∇v) ≤ 0`, lies where [`root_det`]'s scalings leave the normal range, or is a
+//! liquid whose `F_E` is not isotropic (a solid that has just melted) or whose
+//! `det(I + Δt∇v)` is not normal, nothing is written and the caller updates the chunk's
+//! particles one by one, which gives each its exact status.
 //!
 //! [`check_particle`]: crate::particle::update::check_particle
 //! [`thermal::step`]: crate::particle::thermal::step
