@@ -127,9 +127,22 @@ where
     Mat<T, D>: Matrix<Scalar = T>,
 {
     let (a, k) = increment(grad_v, dt)?;
-    let f = a * *f_e;
-    let j = check_det(&f)?;
+    let (f, j) = advance(&a, f_e)?;
     Ok((f, k, j))
+}
+
+/// `A F_E` for an increment `a` of [`increment`], and its determinant, checked
+/// ([`check_det`]).
+///
+/// Errors: those of [`check_det`] for `A F_E`.
+#[inline]
+pub fn advance<T: Real, const D: usize>(a: &Mat<T, D>, f_e: &Mat<T, D>) -> Result<(Mat<T, D>, T)>
+where
+    Mat<T, D>: Matrix<Scalar = T>,
+{
+    let f = *a * *f_e;
+    let j = check_det(&f)?;
+    Ok((f, j))
 }
 
 /// Snow plasticity: returns `(F_E, F_P)` after clamping the singular values of `f_e` to
@@ -245,11 +258,7 @@ where
 {
     let s = match isotropic_scale(f_e) {
         Some(s) if s > T::ZERO => s,
-        _ => {
-            let f = *a * *f_e;
-            check_det(&f)?;
-            return liquid_projection(&f, f_p);
-        }
+        _ => return liquid_projection(&advance(a, f_e)?.0, f_p),
     };
     let det_a = Matrix::det(a);
     let rho = if det_a.is_finite() && det_a >= T::MIN_POSITIVE {

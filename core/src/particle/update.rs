@@ -26,7 +26,7 @@
 //! step refuses.
 
 use super::apic::{self, gather};
-use super::deformation::{check_det, increment, liquid_step, snow_plasticity};
+use super::deformation::{advance, check_det, increment, liquid_step, snow_plasticity};
 use super::dilation;
 use super::stencil::{Grid, Kernel, Stencil};
 use super::thermal::{self, HeatSplit, ThermalState};
@@ -497,8 +497,7 @@ where
             (fe, fp, None)
         }
         (Phase::Solid, plasticity) => {
-            let f_e = a * p.f_e;
-            let j_e = check_det(&f_e)?;
+            let (f_e, j_e) = advance(&a, &p.f_e)?;
             match plasticity {
                 Some(snow) => {
                     let (fe, fp) = snow_plasticity(snow, &f_e, &p.f_p)?;

@@ -439,23 +439,28 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     // A solid (no plasticity): F_E ← A F_E, finite with a finite positive determinant
     // (`check_det`), and it keeps `F_P`. A liquid keeps its volume ratios only, from `det A`
     // (`liquid_step`). In a chunk of both, every lane computes both and takes its own (the
-    // other's checks do not apply).
+    // other's checks do not apply); a chunk of liquids alone forms no product.
+    let liq = zero.lt(V::load(&liquid_flags));
+    let all_liquid = any_liquid && V::all(liq);
+    let f = if all_liquid {
+        f_e // not read: every lane takes the liquid's F_E below
+    } else {
+        let f = product(&inc, &f_e);
+        ok = ok & (det_ok(&f) | liq);
+        f
+    };
     let (f, f_p_new) = if any_liquid {
-        let liq = zero.lt(V::load(&liquid_flags));
         // The solid lanes' `F_P` is selected inside `liquid`, not by `Option::map` here: a
         // closure is not compiled with the caller's target features.
         let (fe, fp, proj_ok) = liquid(&f_e, det_a, &f_p, liq);
         ok = ok & (proj_ok | !liq);
-        if V::all(liq) {
-            (fe, fp)
+        let f = if all_liquid {
+            fe
         } else {
-            let f = product(&inc, &f_e);
-            ok = ok & (det_ok(&f) | liq);
-            (select_mat(liq, &fe, &f), fp)
-        }
+            select_mat(liq, &fe, &f)
+        };
+        (f, fp)
     } else {
-        let f = product(&inc, &f_e);
-        ok = ok & det_ok(&f);
         (f, None)
     };
     if !V::all(ok) {
