@@ -319,10 +319,16 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             fxs[a] = fx;
             // Unused entries are 0, as in `Stencil::new`.
             let (mut w, mut dw) = ([zero; MAX_WIDTH], [zero; MAX_WIDTH]);
-            for o in 0..k {
-                let (n, dn) = kernel.n_dn_lanes(fx - V::splat(T::from_i32(o as i32)));
-                w[o] = n;
-                dw[o] = dn * V::splat(inv_h);
+            match kernel {
+                Kernel::Quadratic => quadratic_axis(fx, &mut w, &mut dw),
+                Kernel::Cubic => {
+                    for o in 0..k {
+                        (w[o], dw[o]) = kernel.n_dn_lanes(fx - V::splat(T::from_i32(o as i32)));
+                    }
+                }
+            }
+            for d in dw.iter_mut().take(k) {
+                *d *= V::splat(inv_h);
             }
             // SAFETY: `out` holds `n = LANES` stencils; record `l` of `rec` scalars from the
             // field of `out[0]` is the same field of `out[l]`, and `w[a]`, `dw[a]` are
@@ -433,6 +439,33 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     pub fn nodes(&self) -> impl Iterator<Item = Node<T, D>> + '_ {
         (0..self.len()).map(move |r| self.node(r))
     }
+}
+
+/// The quadratic B-spline's weights `N(fx − o)` and derivatives `N'(fx − o)` (per cell) at the
+/// three offsets `o` of a stencil, for `fx ∈ [½, ³⁄₂]` (the range [`Stencil::new_lanes`]
+/// forms: `⌊ξ⌋` fraction plus 0 or 1, where the sum may round up to `³⁄₂`): there `fx − o` lies
+/// in the outer piece for `o = 0` and `o = 2` and in the inner piece for `o = 1`, so no piece is
+/// chosen per lane. The operations are those of [`Kernel::n_dn_lanes`] on its piece, in the
+/// same order, and at the ends, where [`Kernel::n_dn_lanes`] takes the other piece or 0, the
+/// two pieces agree exactly (`fx = ½`: ¾ − ¼ = ½·1·1, and `e = 0` for `o = 2`; `fx = ³⁄₂`:
+/// the same for `o = 1`, and `o = 0`, whose `−e` would be `−0`, keeps the select of `+0`), so
+/// the values are the same bits (`quadratic_axis_is_n_dn` checks every `f32` value of `fx`).
+#[inline(always)]
+fn quadratic_axis<V: Lane>(fx: V, w: &mut [V; MAX_WIDTH], dw: &mut [V; MAX_WIDTH]) {
+    let c = |x: f64| V::splat(V::Scalar::from_f64(x));
+    // o = 0: d = fx ∈ [½, ³⁄₂], outer piece ½e², −e with e = ³⁄₂ − d (0 at d = ³⁄₂).
+    let e0 = c(1.5) - fx;
+    w[0] = c(0.5) * e0 * e0;
+    dw[0] = V::select(fx.lt(c(1.5)), -e0, c(0.0));
+    // o = 1: d = fx − 1 ∈ [−½, ½] (exact), inner piece ¾ − d², −2d.
+    let d1 = fx - c(1.0);
+    w[1] = c(0.75) - d1 * d1;
+    dw[1] = -(d1 + d1);
+    // o = 2: d = fx − 2 < 0, outer piece with e = ³⁄₂ − |d| = ³⁄₂ + d (the same real, so the
+    // same rounding) and −sign(d) e = e.
+    let e2 = c(1.5) + (fx - c(2.0));
+    w[2] = c(0.5) * e2 * e2;
+    dw[2] = e2;
 }
 
 /// The cell coordinate `ξ = x/h − shift` of axis `a` (`shift = ½` on the cell-centred axes of

@@ -2,7 +2,7 @@
 //! (which `tests/particle.rs` checks against an independent f64 B-spline), bit for
 //! bit, on every lane type the CPU has.
 
-use super::{Grid, Kernel, Stencil, MAX_CELLS};
+use super::{quadratic_axis, Grid, Kernel, Stencil, MAX_CELLS, MAX_WIDTH};
 use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp, WIDE_LANES};
 use crate::lane::{Isa, Lane};
 use crate::scalar::Real;
@@ -185,4 +185,50 @@ fn invalid_spacing_or_face_does_no_lane() {
     }
     let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Face(3), 1.0, &xs, &mut out);
     assert_eq!(d, 0);
+}
+
+/// [`quadratic_axis`] against [`Kernel::n_dn_lanes`] at `fx − o`, bit for bit, at `fx`.
+fn quadratic_axis_matches<T: Real>(fx: T) {
+    let (mut w, mut dw) = ([T::ZERO; MAX_WIDTH], [T::ZERO; MAX_WIDTH]);
+    quadratic_axis(fx, &mut w, &mut dw);
+    for o in 0..3 {
+        let (n, dn) = Kernel::Quadratic.n_dn_lanes(fx - T::from_i32(o));
+        let (a, b) = (w[o as usize].to_f64(), dw[o as usize].to_f64());
+        assert_eq!(
+            (a.to_bits(), b.to_bits()),
+            (n.to_f64().to_bits(), dn.to_f64().to_bits()),
+            "fx = {:e}, o = {o}: ({a:e}, {b:e}) against ({:e}, {:e})",
+            fx.to_f64(),
+            n.to_f64(),
+            dn.to_f64()
+        );
+    }
+}
+
+/// The quadratic stencil's piece-free weights are the B-spline's, bit for bit, at every `f32`
+/// value of `fx ∈ [½, ³⁄₂]` (the range `new_lanes` forms), and at the ends and a spread of
+/// `f64` values.
+#[test]
+fn quadratic_axis_is_n_dn() {
+    let (lo, hi) = (0.5f32.to_bits(), 1.5f32.to_bits());
+    for b in lo..=hi {
+        quadratic_axis_matches(f32::from_bits(b));
+    }
+    let (lo, hi) = (0.5f64.to_bits(), 1.5f64.to_bits());
+    let step = (hi - lo) / 1_000_003;
+    let ends = [lo, lo + 1, lo + 2, hi - 2, hi - 1, hi];
+    for b in (lo..=hi).step_by(step as usize).chain(ends) {
+        quadratic_axis_matches(f64::from_bits(b));
+    }
+    for fx in [
+        0.5f64,
+        0.75,
+        1.0,
+        1.25,
+        1.5,
+        1.0 - f64::EPSILON / 2.0,
+        1.0 + f64::EPSILON,
+    ] {
+        quadratic_axis_matches(fx);
+    }
 }
