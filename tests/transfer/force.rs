@@ -374,6 +374,9 @@ where
             scale += largest;
         }
         let mut store = Store::from(&ps);
+        // The first vector instruction set's `δf` bits: every other one gives the same (the
+        // same operations in the same order per lane, whatever the register width).
+        let mut vector_bits: Option<(Isa, Vec<u64>)> = None;
         for isa in Isa::available() {
             let mut slots = vec![T::ZERO; n * slot_len(D)];
             // SAFETY: n particles, n slots.
@@ -412,6 +415,15 @@ where
                         "{name} {isa:?}: node {k} axis {a}: {got} vs {} (scale {scale})",
                         w[a]
                     );
+                }
+            }
+            if isa != Isa::SCALAR {
+                let bits: Vec<u64> = (0..D)
+                    .flat_map(|a| df.ch[FORCE + a].iter().map(|x| x.to_f64().to_bits()))
+                    .collect();
+                match &vector_bits {
+                    None => vector_bits = Some((isa, bits)),
+                    Some((first, b)) => assert!(*b == bits, "{name}: {isa:?} against {first:?}"),
                 }
             }
         }

@@ -308,6 +308,31 @@ pub trait Lane:
     }
 }
 
+/// A lane type made of two vectors `R` side by side (halves 0 and 1): for short per-item rows
+/// that can share one register. Where the pair is one register ([`Pair::JOINED`], `f32×16`
+/// holding two `f32×8` on AVX-512), an operation on the pair costs one instruction for both
+/// halves; otherwise ([`X2`]) it costs two, and a caller may as well work on the halves.
+pub trait Pair<R: Lane>: Lane<Scalar = R::Scalar> {
+    /// Both halves are one register.
+    const JOINED: bool;
+    /// The pair with `lo` in half 0 and `hi` in half 1.
+    fn join(lo: R, hi: R) -> Self;
+    /// Half `h` (0 or 1).
+    fn half(self, h: usize) -> R;
+}
+
+impl<R: Lane> Pair<R> for X2<R> {
+    const JOINED: bool = false;
+    #[inline(always)]
+    fn join(lo: R, hi: R) -> Self {
+        X2([lo, hi])
+    }
+    #[inline(always)]
+    fn half(self, h: usize) -> R {
+        self.0[h]
+    }
+}
+
 /// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
 /// (`libm`), so this is also what `no_std` targets run.
 

@@ -26,6 +26,33 @@ arith!(
 );
 kmask!(K16, __mmask16);
 
+/// Two `f32×8` rows in one register: half 0 in lanes 0–7, half 1 in lanes 8–15.
+impl crate::lane::Pair<super::F32x8> for F32x16 {
+    const JOINED: bool = true;
+    #[inline(always)]
+    fn join(lo: super::F32x8, hi: super::F32x8) -> Self {
+        // SAFETY: AVX-512F (this type's instruction set).
+        unsafe {
+            let lo = _mm512_castpd256_pd512(_mm256_castps_pd(lo.0));
+            let pd = _mm512_insertf64x4::<1>(lo, _mm256_castps_pd(hi.0));
+            F32x16(_mm512_castpd_ps(pd))
+        }
+    }
+    #[inline(always)]
+    fn half(self, h: usize) -> super::F32x8 {
+        // SAFETY: as above.
+        unsafe {
+            let pd = _mm512_castps_pd(self.0);
+            let v = if h == 0 {
+                _mm512_castpd512_pd256(pd)
+            } else {
+                _mm512_extractf64x4_pd::<1>(pd)
+            };
+            super::F32x8(_mm256_castpd_ps(v))
+        }
+    }
+}
+
 /// `a ^ b` bitwise on `f32×16` (AVX-512F has it on integers only).
 #[inline(always)]
 unsafe fn xor_ps512(a: __m512, b: __m512) -> __m512 {

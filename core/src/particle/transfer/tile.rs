@@ -34,6 +34,11 @@
 //! The values are those of the per-node formulas up to rounding (products and sums in
 //! another order).
 //!
+//! **Channel pairs.** Where two rows fit one register (`f32` on AVX-512: sixteen lanes), the 3D
+//! tile sums two channels with each instruction, channel `2p` in lanes 0–7 and `2p + 1` in lanes
+//! 8–15 of pair `p` ([`crate::lane::Pair`]); the node values are the same (a channel summed
+//! beside one with more terms gets `+0` for them).
+//!
 //! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
 //! the old values are put back and the run's particles are added one by one by the
 //! per-particle path, which finds the particles that fail. A run's tile sum can be finite where
@@ -42,10 +47,11 @@
 
 use super::nodes::lane_index;
 use super::OutChannel;
-use crate::lane::Lane;
+use crate::lane::{Lane, Pair};
 use crate::mat::Mat;
 use crate::particle::stencil::{Stencil, MAX_WIDTH};
 use crate::scalar::Real;
+use core::marker::PhantomData;
 use core::mem::MaybeUninit;
 
 /// Lanes of a tile row (nodes along axis 0): the eight lanes of the row types of
@@ -57,6 +63,8 @@ pub(super) const MAX_ROWS: usize = 25;
 pub(super) const MAX_RUN: usize = 48;
 /// Most channels written by one P2G call.
 pub(super) const MAX_CH: usize = 10;
+/// Channel pairs of a joined tile (see [`Tile`]).
+const MAX_PAIRS: usize = MAX_CH / 2;
 /// Largest dimension.
 const MAX_D: usize = 3;
 
@@ -89,29 +97,136 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Coef<R, D> {
             has_b: false,
         }
     }
+
+    /// The two channels `lo`, `hi` side by side, every vector as it is: a term that a channel
+    /// lacks must be 0 in it (as [`Coef::only`] and [`set_grad`] leave it).
+    #[inline(always)]
+    fn join_all<Q: Pair<R>>(lo: &Self, hi: &Self) -> Coef<Q, D> {
+        let mut c = Coef::only(Q::join(lo.p, hi.p));
+        c.has_e = lo.has_e || hi.has_e;
+        c.has_b = lo.has_b || hi.has_b;
+        for a in 1..D {
+            c.e[a] = Q::join(lo.e[a], hi.e[a]);
+            c.b[a] = Q::join(lo.b[a], hi.b[a]);
+        }
+        c
+    }
+
+    /// The two channels `lo`, `hi` side by side: the terms either has, a term the other
+    /// lacks 0 in its half (whatever its vector held).
+    #[inline(always)]
+    fn join<Q: Pair<R>>(lo: &Self, hi: &Self) -> Coef<Q, D> {
+        Self::join_all(&lo.own_terms(), &hi.own_terms())
+    }
+
+    /// The channel with 0 for the vectors of the terms it lacks.
+    #[inline(always)]
+    fn own_terms(&self) -> Self {
+        let mut c = *self;
+        for a in 1..D {
+            c.e[a] = term(self.has_e, self.e[a]);
+            c.b[a] = term(self.has_b, self.b[a]);
+        }
+        c
+    }
 }
 
-/// A tile of summed node values per channel.
-pub(super) struct Tile<R, const D: usize> {
+/// A term `v` of a channel, or 0 if the channel does not have it (its vector may be stale).
+#[inline(always)]
+fn term<R: Lane>(has: bool, v: R) -> R {
+    if has {
+        v
+    } else {
+        R::splat(R::Scalar::ZERO)
+    }
+}
+
+/// A tile of summed node values per channel. With rows `R` of one channel and `Q` two rows
+/// side by side: where `Q` is one register ([`Pair::JOINED`]), channels `2p` and `2p + 1`
+/// are summed together as pair `p` (one instruction for both; a channel without a term that
+/// its partner has gets `+0` terms, which leave its finite sums as they are, but for the sign
+/// of a zero sum), else channel by channel.
+#[repr(C, align(64))]
+pub(super) struct Tile<R, Q, const D: usize> {
+    /// Summed node values per channel and row (`acc[j][t]`), or, joined, per channel pair
+    /// and row in the same memory ([`Self::pairs`]).
+    acc: [[R; MAX_ROWS]; MAX_CH],
     /// Origin node, box-relative.
     pub org: [isize; D],
     /// Lanes written per row (bit `l` for lane `l`); no row written: the tile is empty.
     pub bits: [u32; MAX_ROWS],
     /// Whether any row is written.
     pub used: bool,
-    /// Summed node values per channel and row.
-    pub acc: [[R; MAX_ROWS]; MAX_CH],
+    _pair: PhantomData<Q>,
 }
 
-impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
+impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
+    /// Whether channels are summed in pairs: where a pair is one register, in 3D (in 2D, whose
+    /// rows are fewer, joining the channels measured slower than the channels one by one).
+    const PAIRED: bool = Q::JOINED && D == 3;
+
     /// An empty tile.
     #[inline(always)]
     pub fn new() -> Self {
+        const { assert!(size_of::<Q>() == 2 * size_of::<R>() && align_of::<Q>() <= 64) };
         Self {
+            acc: [[R::splat(T::ZERO); MAX_ROWS]; MAX_CH],
             org: [0; D],
             bits: [0; MAX_ROWS],
             used: false,
-            acc: [[R::splat(T::ZERO); MAX_ROWS]; MAX_CH],
+            _pair: PhantomData,
+        }
+    }
+
+    /// The sums as channel pairs (the joined form): pair `p`, row `t`.
+    #[inline(always)]
+    fn pairs(&mut self) -> &mut [[Q; MAX_ROWS]; MAX_PAIRS] {
+        // SAFETY: the same size (`MAX_CH` rows of `R` are `MAX_PAIRS` rows of `Q`, twice the
+        // size), alignment 64 (the struct's, `acc` its first field) at least `Q`'s, and the
+        // lane types are plain vectors or arrays of scalars, valid for any bits.
+        unsafe { &mut *(&raw mut self.acc).cast::<[[Q; MAX_ROWS]; MAX_PAIRS]>() }
+    }
+
+    /// Row `t` of channel `j`.
+    #[inline(always)]
+    fn row(&mut self, j: usize, t: usize) -> R {
+        if Self::PAIRED {
+            self.pairs()[j / 2][t].half(j % 2)
+        } else {
+            self.acc[j][t]
+        }
+    }
+
+    /// Adds channels `coef` (channel `j` at `j`), in pairs when joined.
+    #[inline(always)]
+    fn add_all<const K: usize>(
+        &mut self,
+        rt: &[[usize; MAX_WIDTH]; MAX_WIDTH],
+        st: &Stencil<T, D>,
+        coef: &[Coef<R, D>],
+    ) {
+        if Self::PAIRED {
+            let none = Coef::only(R::splat(T::ZERO));
+            for (p, pair) in coef.chunks(2).enumerate() {
+                let c = Coef::join::<Q>(&pair[0], pair.get(1).unwrap_or(&none));
+                let acc = &mut self.pairs()[p];
+                match (c.has_e, c.has_b) {
+                    (false, false) => add_channel::<T, Q, D, K, false, false>(acc, rt, st, &c),
+                    (true, false) => add_channel::<T, Q, D, K, true, false>(acc, rt, st, &c),
+                    (false, true) => add_channel::<T, Q, D, K, false, true>(acc, rt, st, &c),
+                    (true, true) => add_channel::<T, Q, D, K, true, true>(acc, rt, st, &c),
+                }
+            }
+            return;
+        }
+        for (j, k) in coef.iter().enumerate() {
+            let acc = &mut self.acc[j];
+            match (k.has_e, k.has_b) {
+                (false, false) => add_channel::<T, R, D, K, false, false>(acc, rt, st, k),
+                (true, false) => add_channel::<T, R, D, K, true, false>(acc, rt, st, k),
+                (false, true) => add_channel::<T, R, D, K, false, true>(acc, rt, st, k),
+                (true, true) => add_channel::<T, R, D, K, true, true>(acc, rt, st, k),
+            }
         }
     }
 
@@ -142,16 +257,7 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     #[inline(always)]
     pub fn add<const K: usize>(&mut self, s: &[usize; D], st: &Stencil<T, D>, coef: &[Coef<R, D>]) {
         let rt = self.mark_rows::<K>(s);
-        // Channel by channel, with the terms it has chosen once.
-        for (j, k) in coef.iter().enumerate() {
-            let acc = &mut self.acc[j];
-            match (k.has_e, k.has_b) {
-                (false, false) => add_channel::<T, R, D, K, false, false>(acc, &rt, st, k),
-                (true, false) => add_channel::<T, R, D, K, true, false>(acc, &rt, st, k),
-                (false, true) => add_channel::<T, R, D, K, false, true>(acc, &rt, st, k),
-                (true, true) => add_channel::<T, R, D, K, true, true>(acc, &rt, st, k),
-            }
-        }
+        self.add_all::<K>(&rt, st, coef);
     }
 
     /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`, and
@@ -168,6 +274,23 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     ) {
         debug_assert!(mm[1..=D].iter().all(|k| k.has_e && k.has_b == B));
         let rt = self.mark_rows::<K>(s);
+        if Self::PAIRED {
+            // Pairs in channel order (3D): (mass, momentum 0), (momentum 1, momentum 2), then
+            // the heat channels.
+            let none = Coef::only(R::splat(T::ZERO));
+            let pairs = self.pairs();
+            let c = Coef::join_all::<Q>(&mm[0], &mm[1]);
+            add_channel::<T, Q, D, K, true, B>(&mut pairs[0], &rt, st, &c);
+            let c = Coef::join_all::<Q>(&mm[2], &mm[3]);
+            add_channel::<T, Q, D, K, true, B>(&mut pairs[1], &rt, st, &c);
+            if heat {
+                let c = Coef::join_all::<Q>(&hc[0], &hc[1]);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[2], &rt, st, &c);
+                let c = Coef::join_all::<Q>(&hc[2], &none);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[3], &rt, st, &c);
+            }
+            return;
+        }
         add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0]);
         for a in 1..=D {
             add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &mm[a]);
@@ -190,6 +313,16 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
     ) {
         debug_assert!(coef.iter().all(|k| k.has_e == E && k.has_b == B));
         let rt = self.mark_rows::<K>(s);
+        if Self::PAIRED {
+            let none = Coef::only(R::splat(T::ZERO));
+            let pairs = self.pairs();
+            // (3D) The forces along axes 0 and 1, then along axis 2.
+            let c = Coef::join_all::<Q>(&coef[0], &coef[1]);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[0], &rt, st, &c);
+            let c = Coef::join_all::<Q>(&coef[D - 1], &none);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[1], &rt, st, &c);
+            return;
+        }
         for (acc, k) in self.acc.iter_mut().zip(coef) {
             add_channel::<T, R, D, K, E, B>(acc, &rt, st, k);
         }
@@ -274,7 +407,7 @@ fn add_channel<
     }
 }
 
-impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
+impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
     /// Adds the tile to the channels `outs` (channel `j` gets `acc[j]`, in order) and empties
     /// it. Returns whether every new node value is finite; if one is not, every old value is
     /// put back (last written first, so that aliased channels are restored too).
@@ -298,7 +431,7 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
                 }
                 let p = ch.data.wrapping_offset(self.row_offset::<K>(&ch.stride, t));
                 let x = load_row::<T, R>(p, ch.stride[0], bits);
-                let nv = x + self.acc[j][t];
+                let nv = x + self.row(j, t);
                 ok &= R::all(nv.is_finite());
                 old[j][t].write(x);
                 store_row(nv, p, ch.stride[0], bits);
@@ -317,8 +450,14 @@ impl<T: Real, R: Lane<Scalar = T>, const D: usize> Tile<R, D> {
         }
         for t in 0..rows {
             if self.bits[t] != 0 {
-                for acc in self.acc.iter_mut().take(outs.len()) {
-                    acc[t] = R::splat(T::ZERO);
+                if Self::PAIRED {
+                    for acc in self.pairs().iter_mut().take(outs.len().div_ceil(2)) {
+                        acc[t] = Q::splat(T::ZERO);
+                    }
+                } else {
+                    for acc in self.acc.iter_mut().take(outs.len()) {
+                        acc[t] = R::splat(T::ZERO);
+                    }
                 }
                 self.bits[t] = 0;
             }

@@ -4,7 +4,7 @@
 use super::ForceView;
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
-use crate::lane::{Isa, Lane};
+use crate::lane::{Isa, Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
 use crate::particle::implicit::{apply_entries, apply_slot, slot_len, tag};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
@@ -84,7 +84,12 @@ where
 
     #[inline(always)]
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        with_nodes!(self.kernel, D, |K, N| self.run_nodes::<R, K, N>())
+        self.run_pairs::<V, R, X2<R>>()
+    }
+
+    #[inline(always)]
+    fn run_pairs<V: Lane<Scalar = T>, R: Lane<Scalar = T>, Q: Pair<R>>(&mut self) -> BatchStatus {
+        with_nodes!(self.kernel, D, |K, N| self.run_nodes::<R, Q, K, N>())
     }
 }
 
@@ -102,10 +107,12 @@ where
     /// multiply-adds are fused on the vector instruction sets), then the tile (writes of
     /// `δf`, which no read of `δu` sees).
     #[inline(always)]
-    fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
+    fn run_nodes<R: Lane<Scalar = T>, Q: Pair<R>, const K: usize, const N: usize>(
+        &mut self,
+    ) -> BatchStatus {
         debug_assert_eq!(R::LANES, TILE_X);
         let mut first = FirstFailure::new(self.n);
-        let mut tile = Tile::<R, D>::new();
+        let mut tile = Tile::<R, Q, D>::new();
         let mut run = [0usize; MAX_RUN];
         let mut nrun = 0;
         let (kernel, h) = (self.kernel, self.h);
@@ -155,7 +162,7 @@ where
                 if live[k] {
                     // SAFETY: as above.
                     unsafe {
-                        self.tile_add::<R, K, N>(
+                        self.tile_add::<R, Q, K, N>(
                             start + k,
                             (&stencils[k], &rels[k], &ms[k]),
                             &mut tile,
@@ -168,7 +175,7 @@ where
             start += len;
         }
         // SAFETY: as above.
-        unsafe { self.flush::<R, K, N>(&mut tile, &run[..nrun], &mut first) };
+        unsafe { self.flush::<R, Q, K, N>(&mut tile, &run[..nrun], &mut first) };
         first.status()
     }
 
@@ -178,11 +185,11 @@ where
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn tile_add<R: Lane<Scalar = T>, Q: Pair<R>, const K: usize, const N: usize>(
         &self,
         i: usize,
         (s, rel, m): (&Stencil<T, D>, &[isize; D], &Mat<T, D>),
-        tile: &mut Tile<R, D>,
+        tile: &mut Tile<R, Q, D>,
         (run, nrun): (&mut [usize; MAX_RUN], &mut usize),
         first: &mut FirstFailure,
     ) {
@@ -194,7 +201,7 @@ where
         let sp = match fits {
             Some(sp) => sp,
             None => {
-                self.flush::<R, K, N>(tile, &run[..*nrun], first);
+                self.flush::<R, Q, K, N>(tile, &run[..*nrun], first);
                 *nrun = 0;
                 // An empty tile takes any stencil.
                 tile.place::<K>(rel, &s.fx).unwrap_or([0; D])
@@ -271,9 +278,9 @@ where
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn flush<R: Lane<Scalar = T>, Q: Pair<R>, const K: usize, const N: usize>(
         &self,
-        tile: &mut Tile<R, D>,
+        tile: &mut Tile<R, Q, D>,
         run: &[usize],
         first: &mut FirstFailure,
     ) {

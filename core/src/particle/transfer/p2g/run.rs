@@ -10,7 +10,7 @@ use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithChunks};
 use crate::kernel::chunk::check_bits;
 use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
-use crate::lane::Lane;
+use crate::lane::{Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::Stencil;
 use crate::particle::transfer::nodes::{
@@ -190,26 +190,32 @@ where
     /// particle does not fit in its tile or the run is full.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    unsafe fn tile_add<R: Lane<Scalar = T>, const K: usize, const N: usize, const SET: u8>(
+    unsafe fn tile_add<
+        R: Lane<Scalar = T>,
+        Q: Pair<R>,
+        const K: usize,
+        const N: usize,
+        const SET: u8,
+    >(
         &mut self,
         i: usize,
         r: &Ready<'_, T, D>,
         tau_dev: Mat<T, D>,
-        tile: &mut Tile<R, D>,
+        tile: &mut Tile<R, Q, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) -> Result<()> {
         let rel = rel_base(r.s, &self.view.nodes)?;
         if run.n == MAX_RUN {
-            self.flush::<R, K, N>(tile, run, oc);
+            self.flush::<R, Q, K, N>(tile, run, oc);
         }
         let s = loop {
             if let Some(s) = tile.place::<K>(&rel, &r.s.fx) {
                 break s;
             }
             // An empty tile takes any stencil.
-            self.flush::<R, K, N>(tile, run, oc);
+            self.flush::<R, Q, K, N>(tile, run, oc);
         };
         let idt = self.args.impulse_dt;
         if SET == ANY_CHANNELS {
@@ -235,9 +241,9 @@ where
     /// is left as it was and the run's particles are added one by one ([`Self::scatter`]),
     /// which refuses the ones that overflow.
     #[inline(always)]
-    unsafe fn flush<R: Lane<Scalar = T>, const K: usize, const N: usize>(
+    unsafe fn flush<R: Lane<Scalar = T>, Q: Pair<R>, const K: usize, const N: usize>(
         &mut self,
-        tile: &mut Tile<R, D>,
+        tile: &mut Tile<R, Q, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
     ) {
@@ -274,6 +280,7 @@ where
     #[allow(clippy::too_many_arguments)]
     unsafe fn finish<
         R: Lane<Scalar = T>,
+        Q: Pair<R>,
         const K: usize,
         const N: usize,
         const SET: u8,
@@ -284,7 +291,7 @@ where
         (pre, from_lanes, x): Source<'_, T, D, L>,
         tau_dev: Mat<T, D>,
         lane_stencil: Option<&Stencil<T, D>>,
-        (tile, run): (&mut Tile<R, D>, &mut Run<T, D>),
+        (tile, run): (&mut Tile<R, Q, D>, &mut Run<T, D>),
         oc: &[[T; N]; D],
         coef: &mut [Coef<R, D>; MAX_CH],
     ) {
@@ -306,7 +313,7 @@ where
         };
         let r = match ready {
             Err(e) => Err(e),
-            Ok(r) => self.tile_add::<R, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
+            Ok(r) => self.tile_add::<R, Q, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
         };
         self.first.note(i, r);
     }
@@ -329,14 +336,20 @@ where
     fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
         // In f32 chunks of `V::Wide` (the decomposition's Jacobi rotations are latency-bound,
         // and four independent vectors fill the FMA pipes better than two); see `with_chunks`.
-        T::with_chunks::<V, _>(Chunks::<'_, '_, T, D, R>(self, PhantomData))
+        self.run_pairs::<V, R, X2<R>>()
+    }
+
+    #[inline(always)]
+    fn run_pairs<V: Lane<Scalar = T>, R: Lane<Scalar = T>, Q: Pair<R>>(&mut self) -> BatchStatus {
+        T::with_chunks::<V, _>(Chunks::<'_, '_, T, D, R, Q>(self, PhantomData))
     }
 }
 
 /// [`P2gOp`]'s particle loop with rows `R`, on the chunks [`BatchReal::with_chunks`] picks.
-struct Chunks<'o, 'a, T, const D: usize, R>(&'o mut P2gOp<'a, T, D>, PhantomData<R>);
+struct Chunks<'o, 'a, T, const D: usize, R, Q>(&'o mut P2gOp<'a, T, D>, PhantomData<(R, Q)>);
 
-impl<T: BatchReal, const D: usize, R: Lane<Scalar = T>> WithChunks<T> for Chunks<'_, '_, T, D, R>
+impl<T: BatchReal, const D: usize, R: Lane<Scalar = T>, Q: Pair<R>> WithChunks<T>
+    for Chunks<'_, '_, T, D, R, Q>
 where
     Dim<D>: LaneDim<D>,
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -350,10 +363,10 @@ where
         // (the channel terms known at compile time); other sets, and the cubic kernel, run
         // the per-channel form. Chosen once per call.
         match (op.args.kernel, op.fixed) {
-            (Kernel::Quadratic, Some(heat)) if D == 2 => op.run_fixed::<V, R, 3, 9, L>(heat),
-            (Kernel::Quadratic, Some(heat)) => op.run_fixed::<V, R, 3, 27, L>(heat),
+            (Kernel::Quadratic, Some(heat)) if D == 2 => op.run_fixed::<V, R, Q, 3, 9, L>(heat),
+            (Kernel::Quadratic, Some(heat)) => op.run_fixed::<V, R, Q, 3, 27, L>(heat),
             _ => with_nodes!(op.args.kernel, D, |K, N| {
-                op.run_nodes::<V, R, K, N, ANY_CHANNELS, L>()
+                op.run_nodes::<V, R, Q, K, N, ANY_CHANNELS, L>()
             }),
         }
     }
@@ -370,6 +383,7 @@ where
     fn run_fixed<
         V: Lane<Scalar = T>,
         R: Lane<Scalar = T>,
+        Q: Pair<R>,
         const K: usize,
         const N: usize,
         const L: usize,
@@ -378,9 +392,9 @@ where
         heat: bool,
     ) -> BatchStatus {
         if heat {
-            self.run_nodes::<V, R, K, N, WITH_HEAT, L>()
+            self.run_nodes::<V, R, Q, K, N, WITH_HEAT, L>()
         } else {
-            self.run_nodes::<V, R, K, N, MASS_MOMENTUM, L>()
+            self.run_nodes::<V, R, Q, K, N, MASS_MOMENTUM, L>()
         }
     }
 
@@ -390,6 +404,7 @@ where
     fn run_nodes<
         V: Lane<Scalar = T>,
         R: Lane<Scalar = T>,
+        Q: Pair<R>,
         const K: usize,
         const N: usize,
         const SET: u8,
@@ -400,7 +415,7 @@ where
         debug_assert_eq!(R::LANES, TILE_X);
         debug_assert!(V::LANES <= L);
         let oc = node_offsets::<T, D, K, N>();
-        let mut tile = Tile::<R, D>::new();
+        let mut tile = Tile::<R, Q, D>::new();
         // The tile lane vectors of the particle being added (filled per particle for the
         // active channels; one buffer, so that no per-particle array is initialised).
         let mut coef = [Coef::only(R::splat(T::ZERO)); MAX_CH];
@@ -514,7 +529,7 @@ where
                     let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
                     // SAFETY: `p2g`'s contract: valid channels over the box.
                     unsafe {
-                        self.finish::<R, K, N, SET, L>(
+                        self.finish::<R, Q, K, N, SET, L>(
                             start + l,
                             (&pres[l], from_lanes, &xs[l]),
                             tau,
@@ -529,7 +544,7 @@ where
             start += len;
         }
         // SAFETY: as above.
-        unsafe { self.flush::<R, K, N>(&mut tile, &mut run, &oc) };
+        unsafe { self.flush::<R, Q, K, N>(&mut tile, &mut run, &oc) };
         self.first.status()
     }
 }
