@@ -1,6 +1,6 @@
 //! Failures of P2G and G2P: the status, the first index, and nothing written.
+use crate::isas;
 use crate::{materials, particles, DenseGrid, Store, HC, MOM, TM};
-use ampm_core::lane::Isa;
 use ampm_core::particle::transfer::g2p::{self, G2pArgs};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs};
 use ampm_core::particle::{Grid, Kernel, Particle};
@@ -16,7 +16,7 @@ fn failures_write_nothing() {
     let (cells, hf) = (12, 0.05f64);
     let h = hf as T;
     let (_, thermal) = materials::<T>()[2];
-    for isa in Isa::available() {
+    for isa in isas() {
         let mut rng = Pcg64::seed_from_u64(1);
         let base = particles::<T, D>(&mut rng, 20, hf, cells, &thermal);
         type Case = (&'static str, usize, Box<dyn Fn(&mut Particle<T, D>)>, Error);

@@ -1,5 +1,6 @@
 //! The force differential: reference stiffness (one particle and batches), PSD option, unprepared
 //! slots, overflowing runs.
+use crate::isas;
 use crate::{materials, particles, runs_of_particles, DenseGrid, Store, FORCE, MOM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::kernel::{Dim, LaneDim};
@@ -71,7 +72,7 @@ where
     let h = T::from_f64(hf);
     let eps = T::EPSILON.to_f64();
     for (name, base) in materials::<T>() {
-        for isa in Isa::available() {
+        for isa in isas() {
             let mut rng = Pcg64::seed_from_u64(13);
             let ps = particles::<T, D>(&mut rng, 6, hf, cells, &base);
             for p in &ps {
@@ -207,7 +208,7 @@ fn unprepared_slots_are_refused() {
     let mut store = Store::from(&ps);
     let mut slots = vec![0.0 as T; 3 * slot_len(D)];
     let raw = store.raw();
-    for isa in Isa::available() {
+    for isa in isas() {
         // SAFETY: three particles, three slots.
         let st = unsafe { force::prepare::<T, D>(isa, &mat, 3, &raw, slots.as_mut_ptr()) };
         assert_eq!((st.first_failed, st.error), (1, Some(Error::NonPositiveJ)));
@@ -260,7 +261,7 @@ fn apply_run_that_overflows_is_added_one_by_one() {
     let ps = runs_of_particles::<T, D>(h);
     let mut store = Store::from(&ps);
     let mut slots = vec![0.0 as T; 6 * slot_len(D)];
-    for isa in Isa::available() {
+    for isa in isas() {
         // SAFETY: six particles, six slots.
         let st = unsafe { force::prepare::<T, D>(isa, &mat, 6, &store.raw(), slots.as_mut_ptr()) };
         assert_eq!(st.error, None);
@@ -377,7 +378,7 @@ where
         // The first vector instruction set's `δf` bits: every other one gives the same (the
         // same operations in the same order per lane, whatever the register width).
         let mut vector_bits: Option<(Isa, Vec<u64>)> = None;
-        for isa in Isa::available() {
+        for isa in isas() {
             let mut slots = vec![T::ZERO; n * slot_len(D)];
             // SAFETY: n particles, n slots.
             let st =

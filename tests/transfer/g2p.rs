@@ -1,5 +1,6 @@
 //! G2P: reference match, batch chunks (with and without heat) against single particles, linear
 //! fields, nodes read.
+use crate::isas;
 use crate::{deformation, materials, particles, rand_mat, DenseGrid, Store, HC, LATENT, MOM, TM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::lane::Isa;
@@ -73,7 +74,7 @@ where
     let (cells, hf) = (12, 0.05);
     let h = T::from_f64(hf);
     let dt = T::from_f64(1e-3);
-    for isa in Isa::available() {
+    for isa in isas() {
         for (name, mat) in materials::<T>() {
             for kernel in [Kernel::Quadratic, Kernel::Cubic] {
                 let mut rng = Pcg64::seed_from_u64(5);
@@ -170,7 +171,7 @@ where
     let (cells, hf) = (12, 0.05);
     let h = T::from_f64(hf);
     let dt = T::from_f64(1e-3);
-    for isa in Isa::available() {
+    for isa in isas() {
         for ((name, mat), liquid) in materials::<T>()
             .into_iter()
             .flat_map(|m| [(m.clone(), false), (m, true)])
@@ -332,7 +333,7 @@ where
     };
     let grids = [("warming", grid(1.0)), ("cooling", grid(-1.0))];
     let mats = [("phase change", &thermal), ("no phase change", &no_change)];
-    for isa in Isa::available() {
+    for isa in isas() {
         for ((name, mat), (gname, g)) in mats.iter().flat_map(|m| grids.iter().map(move |g| (m, g)))
         {
             let mut rng = Pcg64::seed_from_u64(12);
@@ -430,7 +431,7 @@ where
         std::array::from_fn(|a| v0[a] + ax[a])
     };
     let mat = materials::<f64>()[0].1;
-    for isa in Isa::available() {
+    for isa in isas() {
         for kernel in [Kernel::Quadratic, Kernel::Cubic] {
             for mac in [false, true] {
                 let ps = particles::<f64, D>(&mut rng, 30, hf, cells, &mat);
@@ -574,7 +575,7 @@ where
         "some particles do not read the node"
     );
     let clean = g2p_grid::<T, D>(cells, 3);
-    for isa in Isa::available() {
+    for isa in isas() {
         let label = format!("{name} {}D {} {isa:?}", D, T::NAME);
         let mut ok = Store::from(&ps);
         let raw = ok.raw();

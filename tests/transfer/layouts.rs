@@ -4,6 +4,7 @@
 //! strides (whole-row loads per channel), for node velocities and (with heat) node
 //! temperatures. All three give the same bits, and every vector instruction set gives the same
 //! bits as the others.
+use crate::isas;
 use crate::{materials, particles, DenseGrid, Store, FORCE, TM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::kernel::{Dim, LaneDim};
@@ -128,7 +129,7 @@ where
     let temps = Layouts::<T, D>::new(&mut rng, cells, (TM - 3.0, TM + 3.0));
     let name = format!("{D}D {} {kernel:?} {mat_name}", T::NAME);
     let mut vector_bits: Option<(Isa, Vec<u64>, Vec<u64>)> = None;
-    for isa in Isa::available() {
+    for isa in isas() {
         let (mut g2p_bits, mut df_bits) = (None::<Vec<u64>>, None::<Vec<u64>>);
         for which in 0..3 {
             let label = format!("{name} {isa:?} layout {which}");

@@ -31,6 +31,7 @@ mod g2p;
 mod layouts;
 mod p2g;
 
+use ampm_core::lane::{Isa, IsaKind};
 use ampm_core::particle::transfer::g2p::G2pView;
 use ampm_core::particle::transfer::p2g::P2gView;
 use ampm_core::particle::transfer::{Channel, NodeBox, Particles};
@@ -228,6 +229,19 @@ impl<T: Real> Store<T> {
             phase: self.phase.as_mut_ptr(),
         }
     }
+}
+
+/// Every instruction set of this CPU, AVX-512 both with and without joined rows
+/// (`Isa::joined_rows`: two eight-lane node rows in one register), so that both forms are
+/// tested on any AVX-512 machine whichever is its default.
+fn isas() -> Vec<Isa> {
+    Isa::available()
+        .into_iter()
+        .flat_map(|i| match i.kind() {
+            IsaKind::Avx512 => vec![i.with_joined_rows(false), i.with_joined_rows(true)],
+            _ => vec![i],
+        })
+        .collect()
 }
 
 fn rand_mat<const D: usize>(rng: &mut Pcg64, r: f64) -> Mat<f64, D>

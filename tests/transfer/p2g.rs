@@ -1,4 +1,5 @@
 //! P2G: reference match, node layouts and batch positions, MAC conservation, overflowing runs.
+use crate::isas;
 use crate::{materials, particles, runs_of_particles, DenseGrid, Store, CH, FORCE, HC, MASS, MOM};
 use ampm_core::kernel::batch::BatchReal;
 use ampm_core::kernel::{Dim, LaneDim};
@@ -107,7 +108,7 @@ where
     let h = T::from_f64(hf);
     for (name, mat) in materials::<T>() {
         for kernel in [Kernel::Quadratic, Kernel::Cubic] {
-            for isa in Isa::available() {
+            for isa in isas() {
                 let mut rng = Pcg64::seed_from_u64(7);
                 let ps = particles::<T, D>(&mut rng, 77, hf, cells, &mat);
                 let mut store = Store::from(&ps);
@@ -186,7 +187,7 @@ fn layouts_and_positions_give_the_same_bits() {
         h,
         impulse_dt: 0.0,
     };
-    for isa in Isa::available() {
+    for isa in isas() {
         let mut sep = DenseGrid::<T, D>::new(lo, dims);
         let mut store = Store::from(&ps);
         let raw = store.raw();
@@ -292,7 +293,7 @@ where
         }
         // Particle 33 (group 32..40) has a NaN velocity.
         near[33].v[0] = T::from_f64(f64::NAN);
-        for isa in Isa::available() {
+        for isa in isas() {
             for k in [0usize, 5, 17, 31, 36, 39, 47, 63, 64, 79] {
                 let mut p = near[k];
                 p.x[0] += T::from_f64(5.0) * h;
@@ -359,7 +360,7 @@ where
     let mat = materials::<T>()[1].1;
     let eps = T::EPSILON.to_f64();
     for kernel in [Kernel::Quadratic, Kernel::Cubic] {
-        for isa in Isa::available() {
+        for isa in isas() {
             let mut rng = Pcg64::seed_from_u64(11);
             let ps = particles::<T, D>(&mut rng, 50, hf, cells, &mat);
             let mut store = Store::from(&ps);
@@ -438,7 +439,7 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
         h: h as T,
         impulse_dt: 1.0e-3,
     };
-    for isa in Isa::available() {
+    for isa in isas() {
         let mut g = DenseGrid::<T, D>::new([0; D], [16; D]);
         // Node (6, 6, 6) is in the stencil of every particle of cell 5 and of none of cell 9.
         let poisoned = g.index([6; D]);
@@ -526,7 +527,7 @@ where
                 impulse_dt: T::from_f64(idt),
             };
             let mut vector_bits: Option<(Isa, Vec<Vec<u64>>)> = None;
-            for isa in Isa::available() {
+            for isa in isas() {
                 let label = format!("{D}D {} {name} impulse {idt} {isa:?}", T::NAME);
                 let mut full = DenseGrid::<T, D>::new(lo, dims);
                 let mut store = Store::from(&ps);

@@ -3,7 +3,8 @@
 //! <fluid|elastic|thermal>` (a development aid; the benchmarks are `c_tests/bench_transfers`
 //! and `tools/benches/particle_levels.rs`). Environment: `AMPM_TT_REPS` (runs, best kept),
 //! `AMPM_TT_ISA` (`avx2`, `avx512`, ...: that instruction set only), `AMPM_TT_SIDE` (particles
-//! per axis), `AMPM_TT_PAD` (more grid nodes per axis).
+//! per axis), `AMPM_TT_PAD` (more grid nodes per axis), `AMPM_TT_JOINED` (`0` or `1`: AVX-512
+//! without or with joined rows, `Isa::joined_rows`; default the CPU's).
 use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
 use ampm_core::particle::transfer::force::{self, ForceView};
@@ -187,6 +188,11 @@ where
         if only.as_deref().is_some_and(|o| o != isa.name()) {
             continue;
         }
+        let isa = match std::env::var("AMPM_TT_JOINED").as_deref() {
+            Ok("0") => isa.with_joined_rows(false),
+            Ok("1") => isa.with_joined_rows(true),
+            _ => isa,
+        };
         let args = P2gArgs {
             kernel: Kernel::Quadratic,
             grid: Grid::Collocated,
@@ -282,9 +288,10 @@ where
             best = (best.0.min(t1), best.1.min(t2), best.2.min(t3));
         }
         println!(
-            "{level}{} {}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
+            "{level}{} {}{}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
             if D == 2 { " 2d" } else { "" },
             isa.name(),
+            if isa.joined_rows() { " joined" } else { "" },
             best.0 / n as f64 * 1e9,
             best.1 / n as f64 * 1e9,
             best.2 / n as f64 * 1e9

@@ -158,6 +158,11 @@ pub(crate) trait LaneOp<T> {
         self.run_rows::<V, R>()
     }
 
+    /// Whether [`Self::run_pairs`] uses `Q` ([`Isa::joined_rows`] then picks it; other loops
+    /// are built once).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    const JOINS_ROWS: bool = false;
+
     /// Whether the AVX-512 build of the loop also enables AVX-512 VL, DQ and BW (which
     /// [`IsaKind::Avx512`] guarantees): eight-lane rows then have 32 registers and k-masked
     /// moves. On for P2G and the force differential (AMD Zen 4: the apply about 15 % faster);
@@ -178,14 +183,22 @@ unsafe fn run_avx2<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
-unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
-    op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
+unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O, joined: bool) -> BatchStatus {
+    if joined && O::JOINS_ROWS {
+        op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
+    } else {
+        op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
+    }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
-unsafe fn run_avx512_vl<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
-    op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
+unsafe fn run_avx512_vl<T: BatchReal, O: LaneOp<T>>(op: &mut O, joined: bool) -> BatchStatus {
+    if joined && O::JOINS_ROWS {
+        op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
+    } else {
+        op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
+    }
 }
 
 /// Runs `op` on the lanes of `isa`.
@@ -198,10 +211,10 @@ pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> Batc
         IsaKind::Avx2 => unsafe { run_avx2::<T, O>(op) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        IsaKind::Avx512 if O::AVX512_VL => unsafe { run_avx512_vl::<T, O>(op) },
+        IsaKind::Avx512 if O::AVX512_VL => unsafe { run_avx512_vl::<T, O>(op, isa.joined_rows()) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        IsaKind::Avx512 => unsafe { run_avx512::<T, O>(op) },
+        IsaKind::Avx512 => unsafe { run_avx512::<T, O>(op, isa.joined_rows()) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => op.run_pairs::<T, ScalarRow<T>, X2<ScalarRow<T>>>(),
     }

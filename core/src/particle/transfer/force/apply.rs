@@ -74,6 +74,8 @@ impl<T: BatchReal, const D: usize> LaneOp<T> for ApplyOp<'_, T, D>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
+    const JOINS_ROWS: bool = true;
+
     const AVX512_VL: bool = true;
 
     #[inline(always)]

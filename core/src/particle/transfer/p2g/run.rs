@@ -325,6 +325,7 @@ where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
     const AVX512_VL: bool = true;
+    const JOINS_ROWS: bool = true;
 
     #[inline(always)]
     fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
