@@ -183,22 +183,22 @@ unsafe fn run_avx2<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx2,fma")]
-unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O, joined: bool) -> BatchStatus {
-    if joined && O::JOINS_ROWS {
-        op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
-    } else {
-        op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
-    }
+unsafe fn run_avx512<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
+    op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
-unsafe fn run_avx512_vl<T: BatchReal, O: LaneOp<T>>(op: &mut O, joined: bool) -> BatchStatus {
-    if joined && O::JOINS_ROWS {
-        op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
-    } else {
-        op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
-    }
+unsafe fn run_avx512_vl<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
+    op.run_pairs::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
+}
+
+/// [`run_avx512_vl`] with joined rows ([`Isa::joined_rows`]): a function of its own, so that
+/// the two forms of a loop do not share (and add up) one stack frame.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
+unsafe fn run_avx512_vl_joined<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
+    op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
 }
 
 /// Runs `op` on the lanes of `isa`.
@@ -211,10 +211,15 @@ pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> Batc
         IsaKind::Avx2 => unsafe { run_avx2::<T, O>(op) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        IsaKind::Avx512 if O::AVX512_VL => unsafe { run_avx512_vl::<T, O>(op, isa.joined_rows()) },
+        IsaKind::Avx512 if O::AVX512_VL && O::JOINS_ROWS && isa.joined_rows() => unsafe {
+            run_avx512_vl_joined::<T, O>(op)
+        },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
-        IsaKind::Avx512 => unsafe { run_avx512::<T, O>(op, isa.joined_rows()) },
+        IsaKind::Avx512 if O::AVX512_VL => unsafe { run_avx512_vl::<T, O>(op) },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        IsaKind::Avx512 => unsafe { run_avx512::<T, O>(op) },
         #[cfg(not(target_arch = "x86_64"))]
         _ => op.run_pairs::<T, ScalarRow<T>, X2<ScalarRow<T>>>(),
     }

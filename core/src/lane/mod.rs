@@ -536,7 +536,8 @@ impl Isa {
     }
 
     /// Whether the particle transfers (P2G, the force differential's apply) sum two eight-lane
-    /// node rows in one sixteen-lane register: AVX-512 `f32` in 3D. The same bits either way.
+    /// node rows in one sixteen-lane register: AVX-512 `f32` in 3D. The same bits either way,
+    /// but for the sign of a zero node sum (see `particle/transfer/tile.rs`).
     #[inline]
     #[must_use]
     pub fn joined_rows(self) -> bool {

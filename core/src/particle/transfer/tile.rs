@@ -36,8 +36,9 @@
 //!
 //! **Channel pairs.** Where two rows fit one register (`f32` on AVX-512: sixteen lanes), the 3D
 //! tile sums two channels with each instruction, channel `2p` in lanes 0–7 and `2p + 1` in lanes
-//! 8–15 of pair `p` ([`crate::lane::Pair`]); the node values are the same (a channel summed
-//! beside one with more terms gets `+0` for them).
+//! 8–15 of pair `p` ([`crate::lane::Pair`]); the node values are the same bits, but that a
+//! channel summed beside one with more terms gets `+0` for them, which turns a `−0` sum into
+//! `+0` (seen only at a node whose grid value was `−0`).
 //!
 //! **Failures.** When the tile is added, every new node value is checked; if one is not finite,
 //! the old values are put back and the run's particles are added one by one by the
