@@ -205,7 +205,8 @@
  * On CPUs that run 512-bit operations at the full rate of two 256-bit ones (AMD Zen 5 and
  * later, detected at run time), 3D f32 `ampm_p2g_*` and `ampm_force_apply_*` sum two node
  * channels per 512-bit register; elsewhere (Intel, where that measured slower) one per 256-bit
- * row. The results are the same bits either way, and the same as under AMPM_ISA_AVX2.
+ * row. The results are the same bits either way, and the same as under AMPM_ISA_AVX2, but for
+ * the sign of a zero: a node that held −0 and receives only zero contributions may become +0.
  */
 #define AMPM_ISA_AVX512 2
 
