@@ -147,7 +147,6 @@ fn term<R: Lane>(has: bool, v: R) -> R {
 /// are summed together as pair `p` (one instruction for both; a channel without a term that
 /// its partner has gets `+0` terms, which leave its finite sums as they are, but for the sign
 /// of a zero sum), else channel by channel.
-#[repr(C, align(64))]
 pub(super) struct Tile<R, Q, const D: usize> {
     /// Summed node values per channel and row (`acc[j][t]`), or, joined, per channel pair
     /// and row in the same memory ([`Self::pairs`]).
@@ -169,7 +168,7 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
     /// An empty tile.
     #[inline(always)]
     pub fn new() -> Self {
-        const { assert!(size_of::<Q>() == 2 * size_of::<R>() && align_of::<Q>() <= 64) };
+        const { assert!(size_of::<R>() == R::LANES * size_of::<T>()) };
         Self {
             acc: [[R::splat(T::ZERO); MAX_ROWS]; MAX_CH],
             org: [0; D],
@@ -179,20 +178,21 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
         }
     }
 
-    /// The sums as channel pairs (the joined form): pair `p`, row `t`.
+    /// The sums as channel pairs (the joined form): pair `p`, row `t`, half `h` of channel
+    /// `2p + h`. Rows of `R`, not `Q`: a tile aligned for `Q` (64 bytes) measured twice the
+    /// stack; the pairs are read and written unaligned ([`PairRows`]).
     #[inline(always)]
-    fn pairs(&mut self) -> &mut [[Q; MAX_ROWS]; MAX_PAIRS] {
-        // SAFETY: the same size (`MAX_CH` rows of `R` are `MAX_PAIRS` rows of `Q`, twice the
-        // size), alignment 64 (the struct's, `acc` its first field) at least `Q`'s, and the
-        // lane types are plain vectors or arrays of scalars, valid for any bits.
-        unsafe { &mut *(&raw mut self.acc).cast::<[[Q; MAX_ROWS]; MAX_PAIRS]>() }
+    fn pairs(&mut self) -> &mut [PairRows<R>; MAX_PAIRS] {
+        // SAFETY: the same size and alignment (`MAX_CH` rows of `R` are `MAX_PAIRS` arrays of
+        // `MAX_ROWS` pairs of `R`; `PairRows` is `repr(transparent)`), and plain data.
+        unsafe { &mut *(&raw mut self.acc).cast::<[PairRows<R>; MAX_PAIRS]>() }
     }
 
     /// Row `t` of channel `j`.
     #[inline(always)]
     fn row(&mut self, j: usize, t: usize) -> R {
         if Self::PAIRED {
-            self.pairs()[j / 2][t].half(j % 2)
+            self.pairs()[j / 2].0[t][j % 2]
         } else {
             self.acc[j][t]
         }
@@ -361,6 +361,48 @@ const fn outer<const D: usize, const K: usize>() -> usize {
     }
 }
 
+/// The tile rows of one channel (or pair of channels) as [`add_channel`] reads and writes them.
+trait Rows<V> {
+    /// Row `t`.
+    fn get(&self, t: usize) -> V;
+    /// Sets row `t`.
+    fn set(&mut self, t: usize, v: V);
+}
+
+impl<V: Copy> Rows<V> for [V; MAX_ROWS] {
+    #[inline(always)]
+    fn get(&self, t: usize) -> V {
+        self[t]
+    }
+    #[inline(always)]
+    fn set(&mut self, t: usize, v: V) {
+        self[t] = v;
+    }
+}
+
+/// The rows of a channel pair: row `t` holds channel `2p` in half 0 and `2p + 1` in half 1,
+/// read and written as one `Q` by unaligned loads and stores.
+#[repr(transparent)]
+struct PairRows<R>([[R; 2]; MAX_ROWS]);
+
+impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>> Rows<Q> for PairRows<R> {
+    #[inline(always)]
+    fn get(&self, t: usize) -> Q {
+        // SAFETY: a pair of `R` is `2 R::LANES` scalars (`Tile::new` checks `R`'s size).
+        let s =
+            unsafe { core::slice::from_raw_parts(self.0[t].as_ptr().cast::<T>(), 2 * R::LANES) };
+        Q::load(s)
+    }
+    #[inline(always)]
+    fn set(&mut self, t: usize, v: Q) {
+        // SAFETY: as above.
+        let s = unsafe {
+            core::slice::from_raw_parts_mut(self.0[t].as_mut_ptr().cast::<T>(), 2 * R::LANES)
+        };
+        v.store(s);
+    }
+}
+
 /// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B`)
 /// into the tile rows `rt` (see [`Tile::add`]): per axis-2 offset `o₂` the vectors `U`, `V`,
 /// `W_B` of the module docs, then per axis-1 offset `o₁` two multiply-adds.
@@ -373,7 +415,7 @@ fn add_channel<
     const E: bool,
     const B: bool,
 >(
-    acc: &mut [R; MAX_ROWS],
+    acc: &mut impl Rows<R>,
     rt: &[[usize; MAX_WIDTH]; MAX_WIDTH],
     st: &Stencil<T, D>,
     k: &Coef<R, D>,
@@ -399,11 +441,11 @@ fn add_channel<
             } else {
                 u
             };
-            let mut a = sp(st.w[1][o1]).mul_add(y, acc[t]);
+            let mut a = sp(st.w[1][o1]).mul_add(y, acc.get(t));
             if B {
                 a = sp(st.dw[1][o1]).mul_add(wb, a);
             }
-            acc[t] = a;
+            acc.set(t, a);
         }
     }
 }
@@ -453,7 +495,7 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
             if self.bits[t] != 0 {
                 if Self::PAIRED {
                     for acc in self.pairs().iter_mut().take(outs.len().div_ceil(2)) {
-                        acc[t] = Q::splat(T::ZERO);
+                        acc.0[t] = [R::splat(T::ZERO); 2];
                     }
                 } else {
                     for acc in self.acc.iter_mut().take(outs.len()) {
