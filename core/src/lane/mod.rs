@@ -317,8 +317,6 @@ pub trait Pair<R: Lane>: Lane<Scalar = R::Scalar> {
     const JOINED: bool;
     /// The pair with `lo` in half 0 and `hi` in half 1.
     fn join(lo: R, hi: R) -> Self;
-    /// Half `h` (0 or 1).
-    fn half(self, h: usize) -> R;
 }
 
 impl<R: Lane> Pair<R> for X2<R> {
@@ -326,10 +324,6 @@ impl<R: Lane> Pair<R> for X2<R> {
     #[inline(always)]
     fn join(lo: R, hi: R) -> Self {
         X2([lo, hi])
-    }
-    #[inline(always)]
-    fn half(self, h: usize) -> R {
-        self.0[h]
     }
 }
 

@@ -38,19 +38,6 @@ impl crate::lane::Pair<super::F32x8> for F32x16 {
             F32x16(_mm512_castpd_ps(pd))
         }
     }
-    #[inline(always)]
-    fn half(self, h: usize) -> super::F32x8 {
-        // SAFETY: as above.
-        unsafe {
-            let pd = _mm512_castps_pd(self.0);
-            let v = if h == 0 {
-                _mm512_castpd512_pd256(pd)
-            } else {
-                _mm512_extractf64x4_pd::<1>(pd)
-            };
-            super::F32x8(_mm256_castpd_ps(v))
-        }
-    }
 }
 
 /// `a ^ b` bitwise on `f32×16` (AVX-512F has it on integers only).
