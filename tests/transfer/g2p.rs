@@ -540,11 +540,12 @@ fn g2p_reads_only_stencil_nodes() {
 }
 
 /// The node sums' statuses on every instruction set, for whole chunks of particles: a node
-/// value of ±∞ or NaN fails exactly the particles whose stencil reads it, with `NonFinite`
-/// (however small their weight there), and leaves them as they were, while the others get the
-/// bits of a clean grid; finite node values whose sums overflow (`T::MAX` at every node: the
-/// gradient sums `Σ v ∂w/∂x` pass ±∞ in their partial sums) give `Overflow`, not `NonFinite`,
-/// and change no particle.
+/// value of ±∞ or NaN (a velocity component, or with heat the new or the old temperature)
+/// fails exactly the particles whose stencil reads it, with `NonFinite` (however small their
+/// weight there), and leaves them as they were, while the others get the bits of a clean grid;
+/// finite node values whose sums overflow (`T::MAX` at every node: the gradient sums
+/// `Σ v ∂w/∂x` pass ±∞ in their partial sums) give `Overflow`, not `NonFinite`, and change no
+/// particle.
 fn g2p_node_statuses<T: BatchReal, const D: usize>()
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
@@ -553,9 +554,15 @@ where
 {
     let (cells, hf) = (12, 0.05);
     let h = T::from_f64(hf);
-    let (name, mat) = materials::<T>().swap_remove(0);
-    let mut rng = Pcg64::seed_from_u64(5);
-    let ps = particles::<T, D>(&mut rng, 40, hf, cells, &mat);
+    let mats = materials::<T>();
+    let thermal = mats.iter().find(|(n, _)| *n == "thermal").unwrap();
+    // (material, the channel that holds the bad value).
+    let cases = [
+        (&mats[0], MOM + 1),
+        (thermal, MOM + 1),
+        (thermal, HC),
+        (thermal, HC + 1),
+    ];
     let args = G2pArgs {
         kernel: Kernel::Quadratic,
         h,
@@ -564,60 +571,67 @@ where
     let stencil = |p: &Particle<T, D>| {
         Stencil::new(Kernel::Quadratic, Grid::Collocated, h, &p.x).expect("inside")
     };
-    // Node 4 of particle 21's stencil (the chunk of particles 16..24), and who reads it.
-    let node = stencil(&ps[21]).node(4).index;
-    let readers: Vec<usize> = (0..ps.len())
-        .filter(|&i| stencil(&ps[i]).nodes().any(|nd| nd.index == node))
-        .collect();
-    assert!(readers.contains(&21));
-    assert!(
-        readers.len() < ps.len(),
-        "some particles do not read the node"
-    );
     let clean = g2p_grid::<T, D>(cells, 3);
-    for isa in isas() {
-        let label = format!("{name} {}D {} {isa:?}", D, T::NAME);
-        let mut ok = Store::from(&ps);
-        let raw = ok.raw();
-        // SAFETY: `raw` holds `ps.len()` particles; the grid covers every stencil.
-        let st =
-            unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &clean.g2p_view(), None) };
-        assert_eq!(st.error, None, "{label}");
-        for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+    for ((name, mat), channel) in cases {
+        let mut rng = Pcg64::seed_from_u64(5);
+        let ps = particles::<T, D>(&mut rng, 40, hf, cells, mat);
+        // Node 4 of particle 21's stencil (the chunk of particles 16..24), and who reads it.
+        let node = stencil(&ps[21]).node(4).index;
+        let readers: Vec<usize> = (0..ps.len())
+            .filter(|&i| stencil(&ps[i]).nodes().any(|nd| nd.index == node))
+            .collect();
+        assert!(readers.contains(&21));
+        assert!(
+            readers.len() < ps.len(),
+            "some particles do not read the node"
+        );
+        for isa in isas() {
+            let label = format!("{name} {}D {} {isa:?} channel {channel}", D, T::NAME);
+            let mut ok = Store::from(&ps);
+            let raw = ok.raw();
+            // SAFETY: `raw` holds `ps.len()` particles; the grid covers every stencil.
+            let st = unsafe {
+                g2p::g2p_update(isa, mat, &args, ps.len(), &raw, &clean.g2p_view(), None)
+            };
+            assert_eq!(st.error, None, "{label}");
+            for bad in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+                let mut g = clean.clone();
+                let k = g.index(node);
+                g.ch[channel][k] = T::from_f64(bad);
+                let mut s = Store::from(&ps);
+                let raw = s.raw();
+                // SAFETY: as above.
+                let st = unsafe {
+                    g2p::g2p_update(isa, mat, &args, ps.len(), &raw, &g.g2p_view(), None)
+                };
+                assert_eq!(
+                    (st.first_failed, st.error),
+                    (readers[0], Some(Error::NonFinite)),
+                    "{label} {bad}"
+                );
+                for i in 0..ps.len() {
+                    let want = if readers.contains(&i) {
+                        ps[i]
+                    } else {
+                        ok.get::<D>(i)
+                    };
+                    assert_eq!(s.get::<D>(i), want, "{label} {bad}: particle {i}");
+                }
+            }
             let mut g = clean.clone();
-            let k = g.index(node);
-            g.ch[MOM + 1][k] = T::from_f64(bad);
+            g.ch[MOM].iter_mut().for_each(|v| *v = T::MAX);
             let mut s = Store::from(&ps);
             let raw = s.raw();
             // SAFETY: as above.
             let st =
-                unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
+                unsafe { g2p::g2p_update(isa, mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
             assert_eq!(
                 (st.first_failed, st.error),
-                (readers[0], Some(Error::NonFinite)),
-                "{label} {bad}"
+                (0, Some(Error::Overflow)),
+                "{label}"
             );
-            for i in 0..ps.len() {
-                let want = if readers.contains(&i) {
-                    ps[i]
-                } else {
-                    ok.get::<D>(i)
-                };
-                assert_eq!(s.get::<D>(i), want, "{label} {bad}: particle {i}");
-            }
+            assert_eq!(s, Store::from(&ps), "{label}: no particle changes");
         }
-        let mut g = clean.clone();
-        g.ch[MOM].iter_mut().for_each(|v| *v = T::MAX);
-        let mut s = Store::from(&ps);
-        let raw = s.raw();
-        // SAFETY: as above.
-        let st = unsafe { g2p::g2p_update(isa, &mat, &args, ps.len(), &raw, &g.g2p_view(), None) };
-        assert_eq!(
-            (st.first_failed, st.error),
-            (0, Some(Error::Overflow)),
-            "{label}"
-        );
-        assert_eq!(s, Store::from(&ps), "{label}: no particle changes");
     }
 }
 

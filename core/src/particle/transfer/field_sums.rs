@@ -304,15 +304,17 @@ unsafe fn contract<
             *pa = first_node(&ch[a], rel);
         }
     }
-    // Σ x·0 over every vector read: NaN exactly when some value read is not finite (one
-    // multiply-add per vector instead of a compare and a mask test).
-    let mut chk = [z; 2];
+    // Σ x·0 over every vector read: NaN exactly when some value read is not finite (a
+    // multiply per vector instead of a compare and a mask test). A row's vectors are combined
+    // off the chain, which is one addition per row: a chain of a multiply-add per vector was
+    // the longest in a particle's sums.
+    let mut chk = z;
     let mut acc = [[z; 2]; 5];
     if D == 2 {
         for o1 in 0..K {
             let u = row::<T, R, D, K, SAME>(ch, &p, [o1, 0], comps);
+            chk += zeros(&u, pv);
             for j in 0..pv {
-                chk[j] = u[j].mul_add(z, chk[j]);
                 acc[0][j] = u[j].mul_add(sp(w[1][o1]), acc[0][j]);
                 acc[1][j] = u[j].mul_add(sp(dw[1][o1]), acc[1][j]);
                 if FULL && o1 > 0 {
@@ -325,8 +327,8 @@ unsafe fn contract<
             let (mut sw, mut sd, mut so) = ([z; 2], [z; 2], [z; 2]);
             for o1 in 0..K {
                 let u = row::<T, R, D, K, SAME>(ch, &p, [o1, o2], comps);
+                chk += zeros(&u, pv);
                 for j in 0..pv {
-                    chk[j] = u[j].mul_add(z, chk[j]);
                     sw[j] = u[j].mul_add(sp(w[1][o1]), sw[j]);
                     sd[j] = u[j].mul_add(sp(dw[1][o1]), sd[j]);
                     if FULL && o1 > 0 {
@@ -349,8 +351,19 @@ unsafe fn contract<
             }
         }
     }
-    let ok = R::all((chk[0] + chk[1]).is_finite());
+    let ok = R::all(chk.is_finite());
     (acc, ok)
+}
+
+/// `Σ_j u[j]·0` over the first `pv` vectors of a row (NaN exactly when a lane is not finite).
+#[inline(always)]
+fn zeros<R: Lane>(u: &[R; 2], pv: usize) -> R {
+    let z = R::splat(R::Scalar::ZERO);
+    if pv == 2 {
+        u[0].mul_add(z, u[1] * z)
+    } else {
+        u[0] * z
+    }
 }
 
 /// The node row with offsets `o₁ = o[0]`, `o₂ = o[1]` of the components read, packed into two
@@ -453,8 +466,8 @@ pub(crate) unsafe fn pair_products<T: Real, R: Lane<Scalar = T>, const D: usize,
         for o1 in 0..K {
             let o = [o1, o2];
             let (va, vb) = pair_row::<T, R, D, K>(pa, pb, &a.stride, &b.stride, o, contiguous);
-            chk = va.mul_add(z, chk);
-            chk = vb.mul_add(z, chk);
+            // `a·0 + b·0` formed off the chain: one addition per row on it, not two FMAs.
+            chk += va.mul_add(z, vb * z);
             sw = (va - vb).mul_add(sp(w[1][o1]), sw);
         }
         acc = if D == 3 {
@@ -534,3 +547,6 @@ fn in_slots<T: Real, R: Lane<Scalar = T>, const K: usize>(f: impl Fn(usize) -> T
     }
     v
 }
+
+#[cfg(test)]
+mod tests;
