@@ -467,7 +467,7 @@ pub(crate) unsafe fn pair_products<T: Real, R: Lane<Scalar = T>, const D: usize,
             let o = [o1, o2];
             let (va, vb) = pair_row::<T, R, D, K>(pa, pb, &a.stride, &b.stride, o, contiguous);
             // `a·0 + b·0` formed off the chain: one addition per row on it, not two FMAs.
-            chk += va.mul_add(z, vb * z);
+            chk += zeros(&[va, vb], 2);
             sw = (va - vb).mul_add(sp(w[1][o1]), sw);
         }
         acc = if D == 3 {

@@ -10,22 +10,12 @@ use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::transfer::nodes::rel_base;
 use crate::particle::transfer::NodeBox;
 use crate::scalar::Real;
+use rand::{Rng, SeedableRng};
+use rand_pcg::Pcg64;
 use std::vec::Vec;
 
 /// Nodes per axis of the test box.
 const CELLS: usize = 12;
-
-/// A small xorshift generator (values in `[0, 1)`).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        (self.0 >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// Runs the comparison with the row type of an instruction set.
 struct Check<'a, T> {
@@ -145,10 +135,11 @@ impl<T: Real> LaneOp<T> for Check<'_, T> {
 }
 
 fn compare<T: BatchReal>() {
-    let mut rng = Rng(0x2545_f491_4f6c_dd1d);
+    let mut rng = Pcg64::seed_from_u64(0x2545_f491_4f6c_dd1d);
     let nn = CELLS * CELLS * CELLS;
     // Values of mixed signs and magnitudes, so that the order of every sum shows in its bits.
-    let mut val = || T::from_f64((rng.next() - 0.5) * libm::exp2(40.0 * rng.next() - 20.0));
+    let mut val =
+        || T::from_f64((rng.random::<f64>() - 0.5) * libm::exp2(40.0 * rng.random::<f64>() - 20.0));
     let sep: [Vec<T>; 3] = core::array::from_fn(|_| (0..nn).map(|_| val()).collect());
     let mut inter = std::vec![T::ZERO; 3 * nn];
     for (i, x) in inter.iter_mut().enumerate() {
@@ -156,7 +147,9 @@ fn compare<T: BatchReal>() {
     }
     // Positions (in cells, h = 1) whose stencils stay inside the box.
     let xs: Vec<[T; 3]> = (0..64 * LANES)
-        .map(|_| core::array::from_fn(|_| T::from_f64(3.0 + (CELLS as f64 - 6.0) * rng.next())))
+        .map(|_| {
+            core::array::from_fn(|_| T::from_f64(3.0 + (CELLS as f64 - 6.0) * rng.random::<f64>()))
+        })
         .collect();
     let mut total = 0;
     for isa in Isa::available() {

@@ -198,24 +198,9 @@ mod tests {
     use super::*;
     use crate::lane::X2;
     use crate::particle::PhaseParams;
-
-    /// A xorshift generator (no dependency for a unit test).
-    struct Rng(u64);
-    impl Rng {
-        fn next(&mut self) -> u64 {
-            self.0 ^= self.0 << 13;
-            self.0 ^= self.0 >> 7;
-            self.0 ^= self.0 << 17;
-            self.0
-        }
-        /// Uniform in `[0, 1)`.
-        fn unit(&mut self) -> f64 {
-            (self.next() >> 11) as f64 / (1u64 << 53) as f64
-        }
-        fn pick<'a, X>(&mut self, xs: &'a [X]) -> &'a X {
-            &xs[self.next() as usize % xs.len()]
-        }
-    }
+    use rand::seq::IndexedRandom;
+    use rand::{Rng, SeedableRng};
+    use rand_pcg::Pcg64;
 
     const TM: f64 = 273.15;
     const L: f64 = 334_000.0;
@@ -245,39 +230,39 @@ mod tests {
     /// boundary: at, just below or above the melting point, with an empty, full, nearly full
     /// or partial buffer (some invalid combinations on purpose), heated or cooled by up to a
     /// few kelvin, or by exactly nothing.
-    fn lane_state(r: &mut Rng) -> (f64, f64, u8, f64, f64) {
-        let liquid = r.next() % 2;
-        let t = match r.next() % 5 {
+    fn lane_state(r: &mut Pcg64) -> (f64, f64, u8, f64, f64) {
+        let liquid = r.random::<u64>() % 2;
+        let t = match r.random::<u64>() % 5 {
             0 | 1 => TM,
-            2 => TM - 20.0 * r.unit(),
-            3 => TM + 20.0 * r.unit(),
-            _ => TM + *r.pick(&[-1e-4, 1e-4, -0.5, 0.5]),
+            2 => TM - 20.0 * r.random::<f64>(),
+            3 => TM + 20.0 * r.random::<f64>(),
+            _ => TM + *[-1e-4, 1e-4, -0.5, 0.5].choose(r).unwrap(),
         };
-        let u = match r.next() % 6 {
+        let u = match r.random::<u64>() % 6 {
             0 => 0.0,
             1 => L,
-            2 => L - 2000.0 * r.unit(),
-            3 => 2000.0 * r.unit(),
-            4 => L * r.unit(),
-            _ => *r.pick(&[0.0, L]),
+            2 => L - 2000.0 * r.random::<f64>(),
+            3 => 2000.0 * r.random::<f64>(),
+            4 => L * r.random::<f64>(),
+            _ => *[0.0, L].choose(r).unwrap(),
         };
         // Valid segment states mostly: snap `U` to the phase's value away from `T_m`.
-        let (u, liquid) = if t < TM && r.next() % 8 != 0 {
+        let (u, liquid) = if t < TM && r.random::<u64>() % 8 != 0 {
             (0.0, 0)
-        } else if t > TM && r.next() % 8 != 0 {
+        } else if t > TM && r.random::<u64>() % 8 != 0 {
             (L, 1)
         } else {
             (u, liquid)
         };
-        let dt = *r.pick(&[0.0, 1.0, -1.0]) * 4.0 * r.unit();
-        let (pic, flip) = if r.next() % 2 == 0 {
+        let dt = *[0.0, 1.0, -1.0].choose(r).unwrap() * 4.0 * r.random::<f64>();
+        let (pic, flip) = if r.random::<u64>() % 2 == 0 {
             (t + dt, dt)
-        } else if r.next() % 4 == 0 {
+        } else if r.random::<u64>() % 4 == 0 {
             // Heated or cooled exactly to `T_m` when `α = 0` (`q` is then exactly the room
             // left in the temperature segment).
             (TM, dt)
         } else {
-            (t + dt * r.unit(), dt * r.unit())
+            (t + dt * r.random::<f64>(), dt * r.random::<f64>())
         };
         (t, u, liquid as u8, pic, flip)
     }
@@ -291,7 +276,7 @@ mod tests {
     ) -> (usize, usize) {
         let heat = mat.heat.unwrap();
         let checked = Checked::new(mat);
-        let mut r = Rng(seed);
+        let mut r = Pcg64::seed_from_u64(seed);
         let (mut lanes_ok, mut scalar_ok) = (0, 0);
         for _ in 0..chunks {
             let mut t = [T::ZERO; LANES];
@@ -299,7 +284,7 @@ mod tests {
             let mut ph = [0u8; LANES];
             let mut cs = super::super::ChunkSamples::<T>::new();
             // Mostly chunks of in-segment lanes; some draw every lane near a boundary.
-            let risky = r.next() % 4 == 0;
+            let risky = r.random::<u64>() % 4 == 0;
             for l in 0..LANES {
                 let (tt, uu, p, pic, fl) = loop {
                     let s = lane_state(&mut r);
