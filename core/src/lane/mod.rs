@@ -92,6 +92,30 @@ pub trait Lane:
     /// # Safety
     /// Every such `base.add(i·stride)` is valid for writing; `i·stride < 2³¹`.
     unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32);
+    /// One short node row per lane, transposed: `out[o]` lane `i` is `*p[i].offset(o·s0)` for
+    /// `o < K ≤ 4` (lanes `K..4` of `out` are 0); `p.len() == LANES`. Scalar loads by default;
+    /// the eight-lane `f32` type loads each row as one masked 4-lane vector when `s0 = 1` and
+    /// transposes in registers (the same values).
+    ///
+    /// # Safety
+    /// Every `p[i].offset(o·s0)`, `i < LANES`, `o < K`, is valid for reading.
+    #[inline(always)]
+    #[must_use]
+    unsafe fn load_rows<const K: usize>(p: &[*const Self::Scalar], s0: isize) -> [Self; 4] {
+        debug_assert!(K <= 4 && p.len() == Self::LANES && Self::LANES <= 16);
+        let mut b = [[Self::Scalar::ZERO; 16]; 4];
+        for (i, q) in p.iter().enumerate() {
+            for (o, bo) in b.iter_mut().enumerate().take(K) {
+                bo[i] = q.offset(o as isize * s0).read_unaligned();
+            }
+        }
+        [
+            Self::load(&b[0]),
+            Self::load(&b[1]),
+            Self::load(&b[2]),
+            Self::load(&b[3]),
+        ]
+    }
     /// Structure-of-arrays view of `LANES` consecutive records of `rec` scalars: `out[c]`
     /// lane `i` is `*base.add(i·rec + c)` for `c < out.len() ≤ rec` (a particle array of
     /// `d × d` matrices, say). Gathers by default; the eight-lane `f32` type loads the records

@@ -120,6 +120,46 @@ impl Lane for F32x8 {
         _mm256_maskstore_ps(p, mask8(n), self.0)
     }
     #[inline(always)]
+    unsafe fn load_rows<const K: usize>(p: &[*const f32], s0: isize) -> [Self; 4] {
+        debug_assert!(K <= 4 && p.len() == 8);
+        if s0 != 1 {
+            let mut b = [[0.0f32; 8]; 4];
+            for (i, q) in p.iter().enumerate() {
+                for (o, bo) in b.iter_mut().enumerate().take(K) {
+                    bo[i] = q.offset(o as isize * s0).read_unaligned();
+                }
+            }
+            return [
+                Self::load(&b[0]),
+                Self::load(&b[1]),
+                Self::load(&b[2]),
+                Self::load(&b[3]),
+            ];
+        }
+        // Row `i` in lanes 0..4 of a 128-bit load (lanes `K..4` masked off: not read), rows `i`
+        // and `i + 4` in the two halves of one vector, then a 4 × 4 transpose within each half:
+        // `out[o]` holds node `o` of rows 0..4 in lanes 0..4 and of rows 4..8 in lanes 4..8.
+        // (No closures: a closure would not inherit the caller's target features.)
+        let on = [0, 1, 2, 3].map(|o| if o < K { -1 } else { 0 });
+        let m = _mm_setr_epi32(on[0], on[1], on[2], on[3]);
+        let mut a = [_mm256_setzero_ps(); 4];
+        for (i, ai) in a.iter_mut().enumerate() {
+            let lo = _mm256_castps128_ps256(_mm_maskload_ps(p[i], m));
+            *ai = _mm256_insertf128_ps::<1>(lo, _mm_maskload_ps(p[i + 4], m));
+        }
+        let [a0, a1, a2, a3] = a;
+        let t0 = _mm256_unpacklo_ps(a0, a1);
+        let t1 = _mm256_unpackhi_ps(a0, a1);
+        let t2 = _mm256_unpacklo_ps(a2, a3);
+        let t3 = _mm256_unpackhi_ps(a2, a3);
+        [
+            F32x8(_mm256_shuffle_ps::<0x44>(t0, t2)),
+            F32x8(_mm256_shuffle_ps::<0xEE>(t0, t2)),
+            F32x8(_mm256_shuffle_ps::<0x44>(t1, t3)),
+            F32x8(_mm256_shuffle_ps::<0xEE>(t1, t3)),
+        ]
+    }
+    #[inline(always)]
     unsafe fn load_mask(p: *const f32, bits: u32) -> Self {
         F32x8(_mm256_maskload_ps(p, mask8_bits(bits)))
     }

@@ -1,6 +1,8 @@
 //! Sums over a stencil's nodes of a node vector field by separable contraction: the gradient
-//! `G = Σ_i u_i ∇w_iᵀ` (the force differential's `δu`) and, for G2P, also `Σ_i w_i v_i` and
-//! the moments `Σ_i w_i v_i o_iᵀ` (`o` the node offset from the stencil base).
+//! `G = Σ_i u_i ∇w_iᵀ` (the force differential's `δu`) and, for G2P on a MAC grid's faces, also
+//! `Σ_i w_i v_i` and the moments `Σ_i w_i v_i o_iᵀ` (`o` the node offset from the stencil base);
+//! and G2P's temperature pair ([`pair_sums`]). (G2P's collocated velocity sums run one particle
+//! per lane instead, in `lane_sums.rs`.)
 //!
 //! With the tensor-product weights `w_i = Π_a w_a[o_a]` and `∂w_i/∂x_b` the same product with
 //! `dw_b` for `w_b` ([`Stencil`]), each sum factors axis by axis (3D; 2D drops the `o₂` level):
@@ -27,9 +29,10 @@
 //! `f64` and scalar rows, where the regrouping in registers measured slower; in 3D, with two
 //! vectors per output, horizontal adds measured slower in the C library too). Every lane's
 //! operations, in order, are the same on every eight-lane row type and instruction set, so
-//! they give the same bits. A chunk of eight particles (G2P in 3D) can instead have the
-//! same sums of each output made for all eight at once, one particle per lane
-//! ([`chunk_sums`]): one 8 × 8 transpose in registers instead of eight particles' stored lanes.
+//! they give the same bits. A chunk of eight particles can instead have the temperature pair's
+//! lane sums made for all eight at once, one particle per lane ([`chunk_sums`] of
+//! [`pair_products`]): one 8 × 8 transpose in registers instead of eight particles' stored
+//! lanes.
 
 use super::InChannel;
 use crate::lane::Lane;
@@ -66,47 +69,6 @@ impl<T: Real, const D: usize> Sums<T, D> {
             _ => self.mo.cols[q - D - 1][a] = sum,
         }
     }
-}
-
-/// Outputs of the field sums with `Σ w u` and the moments: `d` gradient columns, `Σ w u`,
-/// `d` moments.
-pub(crate) const MAX_OUT: usize = 7;
-
-/// The products of [`node_field_sums`] with `FULL` before their lane sums, for
-/// [`chunk_sums`]: `p[q][j]` is vector `j` of output `q` (the gradient's columns `0..d`, then
-/// `Σ w u` and the moments `0..d`, the order of [`Sums::put`]), each component's `K` terms in
-/// its lanes as in the module docs, the other lanes `+0`; and whether every value read is
-/// finite. The same contraction and factors as [`node_field_sums`] ([`contract_rows`], the same
-/// bits); its output table is kept apart because sharing it measured 20% slower 2D `f32` G2P
-/// and apply.
-///
-/// # Safety
-/// As [`node_field_sums`].
-#[inline(always)]
-pub(crate) unsafe fn node_field_products<
-    T: Real,
-    R: Lane<Scalar = T>,
-    const D: usize,
-    const K: usize,
->(
-    s: &Stencil<T, D>,
-    rel: &[isize; D],
-    ch: &[InChannel<T, D>; D],
-) -> ([[R; 2]; MAX_OUT], bool) {
-    debug_assert!(R::LANES == LANES && K <= SLOT && (D == 2 || D == 3));
-    let (acc, finite, [f_w, f_dw, f_wo]) = contract_rows::<T, R, D, K, true>(ch, rel, s, (0, D));
-    let mut p = [[R::splat(T::ZERO); 2]; MAX_OUT];
-    for j in 0..D.div_ceil(2) {
-        for b in 0..D {
-            p[b][j] = acc[b][j] * if b == 0 { f_dw } else { f_w };
-        }
-        p[D][j] = acc[0][j] * f_w;
-        p[D + 1][j] = acc[0][j] * f_wo;
-        for b in 1..D {
-            p[D + 1 + b][j] = acc[2 + b][j] * f_w;
-        }
-    }
-    (p, finite)
 }
 
 /// The [`Sums`] over the `N = K^d` nodes of stencil `s` (`K ≤ 4`, `d` 2 or 3) of the components
@@ -219,9 +181,9 @@ pub(crate) unsafe fn node_field_sums<
 }
 
 /// The lane sums of one product vector of eight particles at once: `[s₀, s₁]`, lane `l` of
-/// `s_c` the sum of `v[l]`'s slot `c` (lanes `4c..4c + K`) in order from lane `4c`, as the 3D
-/// [`node_field_sums`] and [`pair_sums`] form it. One 8 × 8 transpose ([`Lane::transpose8`])
-/// puts particle `l`'s lanes in lane `l`, so the sums are vector adds.
+/// `s_c` the sum of `v[l]`'s slot `c` (lanes `4c..4c + K`) in order from lane `4c`, as
+/// [`pair_sums`] forms it. One 8 × 8 transpose ([`Lane::transpose8`]) puts particle `l`'s lanes
+/// in lane `l`, so the sums are vector adds.
 #[inline(always)]
 pub(crate) fn chunk_sums<R: Lane, const K: usize>(v: [R; LANES]) -> [R; 2] {
     debug_assert!(R::LANES == LANES && K <= SLOT);
@@ -238,7 +200,7 @@ pub(crate) fn chunk_sums<R: Lane, const K: usize>(v: [R; LANES]) -> [R; 2] {
 /// [`contract`] of the components `comps` with its layout chosen (separate node arrays of one
 /// box, the usual layout, share their strides: one row offset for every component, and
 /// whole-row loads), and the axis-0 factors `[w, w′, w·o₀]` in the lanes of their offsets:
-/// the part shared by [`node_field_sums`] and [`node_field_products`].
+/// for [`node_field_sums`].
 ///
 /// # Safety
 /// As [`node_field_sums`].
@@ -523,7 +485,10 @@ unsafe fn pair_row<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>
 /// # Safety
 /// The node is inside the channel's box.
 #[inline(always)]
-unsafe fn first_node<T, const D: usize>(c: &InChannel<T, D>, rel: &[isize; D]) -> *const T {
+pub(super) unsafe fn first_node<T, const D: usize>(
+    c: &InChannel<T, D>,
+    rel: &[isize; D],
+) -> *const T {
     let mut off = 0;
     for d in 0..D {
         off += rel[d] * c.stride[d];

@@ -10,9 +10,8 @@
 //! With `x_i − x_p = (o − fx) h` ([`Stencil::fx`]), `C_p = (Σ w_i v_i oᵀ − v_p fxᵀ)/(κ h)`: no
 //! per-node subtraction.
 
-use super::field_sums::{
-    chunk_sums, node_field_products, node_field_sums, pair_products, pair_sums, Sums, MAX_OUT,
-};
+use super::field_sums::{chunk_sums, node_field_sums, pair_products, pair_sums};
+use super::lane_sums::chunk_field_sums;
 use super::nodes::{rel_base, taint, with_nodes};
 use super::update_lanes::{self, ChunkSamples};
 use super::{chunk_stencils, BatchStatus, Checked, FirstFailure, InChannel, NodeBox};
@@ -155,9 +154,9 @@ where
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, const K: usize, const N: usize>(&mut self) -> BatchStatus {
         let mut first = FirstFailure::new(self.n);
-        // Chunks of elastic solids or of liquids (after their heat step) are updated on the row
-        // type's eight lanes.
-        let lanes = R::LANES == CHUNK;
+        // The row types have eight lanes: a chunk's samples and updates run one particle per
+        // lane.
+        const { assert!(R::LANES == CHUNK) };
         let mut cs = ChunkSamples::new();
         // The chunk's samples and their statuses, written in place: a sample returned by value
         // (in a `Result`) is copied with wide moves right after its fields were stored one by
@@ -189,63 +188,50 @@ where
                     &mut stencils,
                 )
             };
-            let whole = lanes && len == CHUNK;
-            // A whole 3D chunk on the collocated grid with every stencil from the lanes: its
-            // samples on the lanes too, where the row type transposes in registers (in 2D the
-            // per-particle sums in registers, `Lane::quad_sums`, measured faster).
-            // SAFETY: `g2p_update`'s contract.
-            let sampled = whole
-                && D == 3
-                && done == (1 << CHUNK) - 1
-                && self.faces.is_none()
-                && R::TRANSPOSE8_IN_REGISTERS
-                && unsafe {
-                    sample_chunk::<T, R, D, K>(
+            let whole = len == CHUNK;
+            // The stencils that the lanes did not make, with their errors.
+            for (k, st) in status.iter_mut().enumerate().take(len) {
+                *st = if done >> k & 1 == 1 {
+                    Ok(())
+                } else {
+                    Stencil::new(kernel, Grid::Collocated, h, &xs[k]).map(|s| stencils[k] = s)
+                };
+            }
+            match self.faces {
+                // SAFETY: `g2p_update`'s contract.
+                None => unsafe {
+                    sample_lanes::<T, R, D, K>(
                         self.material,
                         self.args,
-                        &stencils,
+                        (&stencils, len),
                         self.view,
+                        &mut status,
                         &mut cs,
                     )
-                };
-            let mut all_ok = true;
-            if sampled {
-                // The update below writes nothing if it refuses; the fallback needs the samples.
-                status = [Ok(()); CHUNK];
-            } else {
-                for (k, (out, st)) in samples.iter_mut().zip(&mut status).enumerate().take(len) {
-                    *st = if done >> k & 1 == 1 {
-                        Ok(())
-                    } else {
-                        match Stencil::new(kernel, Grid::Collocated, h, &xs[k]) {
-                            Ok(s) => {
-                                stencils[k] = s;
-                                Ok(())
+                },
+                Some(faces) => {
+                    for (k, (out, st)) in samples.iter_mut().zip(&mut status).enumerate() {
+                        if k < len && st.is_ok() {
+                            // SAFETY: `g2p_update`'s contract.
+                            *st = unsafe {
+                                sample_faces::<T, R, D, K, N>(
+                                    self.material,
+                                    self.args,
+                                    &xs[k],
+                                    &stencils[k],
+                                    self.view,
+                                    faces,
+                                    out,
+                                )
+                            };
+                            if st.is_ok() {
+                                cs.set(k, out);
                             }
-                            Err(e) => Err(e),
                         }
-                    };
-                    if st.is_ok() {
-                        // SAFETY: `g2p_update`'s contract.
-                        *st = unsafe {
-                            sample::<T, R, D, K, N>(
-                                self.material,
-                                self.args,
-                                &xs[k],
-                                &stencils[k],
-                                self.view,
-                                self.faces,
-                                out,
-                            )
-                        };
-                    }
-                    if lanes && st.is_ok() {
-                        cs.set(k, out);
-                    } else {
-                        all_ok = false;
                     }
                 }
             }
+            let all_ok = status[..len].iter().all(Result::is_ok);
             // SAFETY: as above.
             if whole
                 && all_ok
@@ -264,8 +250,8 @@ where
                 start += len;
                 continue;
             }
-            if sampled {
-                for (k, smp) in samples.iter_mut().enumerate() {
+            if self.faces.is_none() {
+                for (k, smp) in samples.iter_mut().enumerate().take(len) {
                     *smp = cs.get(k);
                 }
             }
@@ -321,24 +307,31 @@ where
     Ok(())
 }
 
-/// The grid sample of a particle at `x` with collocated stencil `s`, written to `out` (in
-/// part on error).
+/// The grid sample of a particle at `x` with collocated stencil `s` on a MAC grid: velocity
+/// component `a` from face grid `a` ([`node_field_sums`] over the face stencil), temperatures
+/// from the collocated `view`; written to `out` (in part on error).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-unsafe fn sample<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+unsafe fn sample_faces<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const N: usize,
+>(
     material: &Material<T>,
     args: &G2pArgs<T>,
     x: &[T; D],
     s: &Stencil<T, D>,
     view: &G2pView<T, D>,
-    faces: Option<&[G2pView<T, D>; D]>,
+    faces: &[G2pView<T, D>; D],
     out: &mut G2pSample<T, D>,
 ) -> Result<()>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    // The collocated box is read for velocities (collocated grid) and temperatures (heat on).
-    let rel = if faces.is_none() || material.heat.is_some() {
+    // The collocated box is read for temperatures (heat on).
+    let rel = if material.heat.is_some() {
         rel_base(s, &view.nodes)?
     } else {
         [0; D]
@@ -351,29 +344,15 @@ where
     out.t_pic = T::ZERO;
     out.t_flip = T::ZERO;
     let mut finite = true;
-    let mut put = |a: usize, st: &Stencil<T, D>, sm: &Sums<T, D>| {
+    for a in 0..D {
+        let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
+        let rl = rel_base(&st, &faces[a].nodes)?;
+        let sm = node_field_sums::<T, R, D, K, true>(&st, &rl, &faces[a].velocity, (a, a + 1));
+        finite &= sm.finite;
         out.v[a] = sm.v[a];
         for b in 0..D {
             out.affine.cols[b][a] = (sm.mo.cols[b][a] - sm.v[a] * st.fx[b]) * inv_kh;
             out.grad_v.cols[b][a] = sm.g.cols[b][a];
-        }
-    };
-    match faces {
-        None => {
-            let sm = node_field_sums::<T, R, D, K, true>(s, &rel, &view.velocity, (0, D));
-            finite &= sm.finite;
-            for a in 0..D {
-                put(a, s, &sm);
-            }
-        }
-        Some(f) => {
-            for a in 0..D {
-                let st = Stencil::new(args.kernel, Grid::Face(a), args.h, x)?;
-                let rl = rel_base(&st, &f[a].nodes)?;
-                let sm = node_field_sums::<T, R, D, K, true>(&st, &rl, &f[a].velocity, (a, a + 1));
-                finite &= sm.finite;
-                put(a, &st, &sm);
-            }
         }
     }
     if material.heat.is_some() {
@@ -399,101 +378,127 @@ where
     Ok(())
 }
 
-/// The grid samples of a whole chunk of particles on the collocated 3D grid (`stencils`, one
-/// per particle), written to `cs` one particle per lane: each particle's products
-/// ([`node_field_products`], with heat on [`pair_products`]), then each output's lane sums for
-/// the eight particles at once ([`chunk_sums`], in the order of [`node_field_sums`] and
-/// [`pair_sums`] in 3D), then `C_p` and the checks on the lanes: the operations of [`sample`] in its
-/// order, so the same bits, without a particle's scalar sums and checks. Returns whether every
-/// particle's sample succeeds; if not (a stencil outside the box, a non-finite node value
-/// read, a sum that overflows), `cs` is partly written and the caller samples particle by
-/// particle, which gives each its status.
+/// The grid samples of the chunk's first `len` particles on the collocated grid (their
+/// `stencils`), one particle per lane of `R`, written to `cs`: the velocity sums of
+/// [`chunk_field_sums`]; with heat on each particle's temperature pair ([`pair_sums`], or for a
+/// chunk whose eight particles all sample, [`chunk_sums`] of their
+/// [`pair_products`] where the row type transposes in registers: the same bits); then
+/// `C_p = (Σ w v oᵀ − v fxᵀ)/(κ h)` and the checks on the lanes. On entry `status[k]` is
+/// particle `k`'s stencil status; on return its sample's status, with the errors in this
+/// order: outside the box, `1/(κ h)` not finite ([`Error::Overflow`]), a node value read that
+/// is not finite ([`Error::NonFinite`]), a sum that overflows ([`Error::Overflow`]). Lane `k`
+/// of `cs` is the sample where the status is `Ok`.
 ///
 /// # Safety
 /// As [`g2p_update`], for the chunk's particles.
 #[inline(always)]
-unsafe fn sample_chunk<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
+unsafe fn sample_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
     material: &Material<T>,
     args: &G2pArgs<T>,
-    stencils: &[Stencil<T, D>; CHUNK],
+    (stencils, len): (&[Stencil<T, D>; CHUNK], usize),
     view: &G2pView<T, D>,
+    status: &mut [Result<()>; CHUNK],
     cs: &mut ChunkSamples<T>,
-) -> bool {
+) {
+    // The lanes that sample: a stencil inside the box.
+    let mut rel = [[0isize; D]; CHUNK];
+    let mut live = 0u32;
+    for (k, (st, r)) in status.iter_mut().zip(&mut rel).enumerate().take(len) {
+        if st.is_ok() {
+            match rel_base(&stencils[k], &view.nodes) {
+                Ok(x) => {
+                    *r = x;
+                    live |= 1 << k;
+                }
+                Err(e) => *st = Err(e),
+            }
+        }
+    }
+    if live == 0 {
+        return;
+    }
     let inv_kh = T::ONE / (args.kernel.apic_moment::<T>() * args.h);
     if !inv_kh.is_finite() {
-        return false;
+        for (k, st) in status.iter_mut().enumerate() {
+            if live >> k & 1 == 1 {
+                *st = Err(Error::Overflow);
+            }
+        }
+        return;
     }
-    let heat = material.heat.is_some();
     let z = R::splat(T::ZERO);
-    // prods[q][j][k]: vector `j` of output `q` (as in `node_field_products`) of particle `k`.
-    let nq = 2 * D + 1;
-    let mut prods = [[[z; CHUNK]; 2]; MAX_OUT];
-    let mut heat_prods = [z; CHUNK];
-    let mut finite = true;
-    for (k, s) in stencils.iter().enumerate() {
-        let Ok(rel) = rel_base(s, &view.nodes) else {
-            return false;
-        };
-        let (pr, ok) = node_field_products::<T, R, D, K>(s, &rel, &view.velocity);
-        finite &= ok;
-        for (pq, p) in prods.iter_mut().zip(&pr).take(nq) {
-            for j in 0..D.div_ceil(2) {
-                pq[j][k] = p[j];
+    // Lanes that read a temperature that is not finite.
+    let mut heat_bad = 0u64;
+    let (mut pic, mut flip) = (z, z);
+    if material.heat.is_some() {
+        let all = live == (1 << CHUNK) - 1;
+        if all && R::TRANSPOSE8_IN_REGISTERS {
+            let mut prods = [z; CHUNK];
+            for (k, (p, r)) in prods.iter_mut().zip(&rel).enumerate() {
+                let (x, ok) = pair_products::<T, R, D, K>(
+                    &stencils[k],
+                    r,
+                    &view.temperature,
+                    &view.temperature_old,
+                );
+                *p = x;
+                heat_bad |= u64::from(!ok) << k;
             }
-        }
-        if heat {
-            let (p, ok) =
-                pair_products::<T, R, D, K>(s, &rel, &view.temperature, &view.temperature_old);
-            finite &= ok;
-            heat_prods[k] = p;
-        }
-    }
-    if !finite {
-        return false;
-    }
-    // sums[q][a]: output `q`, component `a`, particle `l` in lane `l`.
-    let mut sums = [[z; 3]; MAX_OUT];
-    for (sq, pq) in sums.iter_mut().zip(&prods).take(nq) {
-        for j in 0..D.div_ceil(2) {
-            let s = chunk_sums::<R, K>(pq[j]);
-            sq[2 * j] = s[0];
-            if 2 * j + 1 < D {
-                sq[2 * j + 1] = s[1];
+            [pic, flip] = chunk_sums::<R, K>(prods);
+        } else {
+            let (mut tp, mut tf) = ([T::ZERO; CHUNK], [T::ZERO; CHUNK]);
+            for k in 0..len {
+                if live >> k & 1 == 1 {
+                    let (a, b, ok) = pair_sums::<T, R, D, K>(
+                        &stencils[k],
+                        &rel[k],
+                        &view.temperature,
+                        &view.temperature_old,
+                    );
+                    (tp[k], tf[k]) = (a, b);
+                    heat_bad |= u64::from(!ok) << k;
+                }
             }
+            (pic, flip) = (R::load(&tp), R::load(&tf));
         }
     }
+    // The velocity sums after the temperatures' (measured faster in this order).
+    let sm = chunk_field_sums::<T, R, D, K, true>(stencils, &rel, live, &view.velocity);
     // The stencils' `fx` by axis, particle `l` in lane `l` (records of a stencil's size).
     let mut fx = [z; 3];
     debug_assert!(size_of::<Stencil<T, D>>() % size_of::<T>() == 0);
     let rec = size_of::<Stencil<T, D>>() / size_of::<T>();
-    let fx0 = stencils
-        .as_ptr()
-        .cast::<u8>()
-        .add(core::mem::offset_of!(Stencil<T, D>, fx))
-        .cast::<T>();
+    let fx0 = core::ptr::addr_of!((*stencils.as_ptr()).fx).cast::<T>();
     R::load_records(fx0, rec, &mut fx[..D]);
-    // As `sample`: `v`, `C_p = (Σ w v oᵀ − v fxᵀ)/(κ h)`, `∇v`, every one finite.
+    // As `sample_faces`: `v`, `C_p = (Σ w v oᵀ − v fxᵀ)/(κ h)`, `∇v`, every one finite.
     let inv = R::splat(inv_kh);
     let mut ok = z.eq(z);
     for a in 0..D {
-        let v = sums[D][a];
+        let v = sm.v[a];
         ok = ok & v.is_finite();
         v.store(&mut cs.v[a]);
         for b in 0..D {
-            let c = (sums[D + 1 + b][a] - v * fx[b]) * inv;
-            let g = sums[b][a];
+            let c = (sm.mo[b][a] - v * fx[b]) * inv;
+            let g = sm.g[b][a];
             ok = ok & c.is_finite() & g.is_finite();
             c.store(&mut cs.affine[a + D * b]);
             g.store(&mut cs.grad_v[a + D * b]);
         }
     }
-    let [pic, flip] = if heat {
-        chunk_sums::<R, K>(heat_prods)
-    } else {
-        [z; 2]
-    };
     ok = ok & pic.is_finite() & flip.is_finite();
     pic.store(&mut cs.t_pic);
     flip.store(&mut cs.t_flip);
-    R::all(ok)
+    let read_bad = !R::mask_bits(sm.chk.is_finite()) | heat_bad;
+    let sums_ok = R::mask_bits(ok);
+    for (k, st) in status.iter_mut().enumerate() {
+        if live >> k & 1 == 1 {
+            *st = if read_bad >> k & 1 == 1 {
+                Err(Error::NonFinite)
+            } else if sums_ok >> k & 1 == 0 {
+                Err(Error::Overflow)
+            } else {
+                Ok(())
+            };
+        }
+    }
 }

@@ -32,8 +32,11 @@
 mod field_sums;
 pub mod force;
 pub mod g2p;
+mod lane_sums;
 mod nodes;
 pub mod p2g;
+#[cfg(test)]
+mod row_check;
 mod tile;
 mod update_lanes;
 

@@ -1,13 +1,13 @@
-//! The sums of eight particles at once ([`chunk_sums`] of [`node_field_products`], G2P's
-//! samples and the force differential's `G` in 3D) against each particle's own
-//! [`node_field_sums`], bit for bit, on every row type the CPU has, on separate node arrays
-//! and on interleaved nodes.
+//! The temperature pair's sums of eight particles at once ([`chunk_sums`] of
+//! [`pair_products`], G2P's chunks) against each particle's own [`pair_sums`], bit for bit, on
+//! every row type the CPU has, on separate node arrays and on interleaved nodes.
 
-use super::{chunk_sums, node_field_products, node_field_sums, InChannel, LANES, MAX_OUT};
-use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp};
+use super::{chunk_sums, pair_products, pair_sums, InChannel, LANES};
+use crate::kernel::batch::{dispatch, BatchReal};
 use crate::lane::{Isa, Lane};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::transfer::nodes::rel_base;
+use crate::particle::transfer::row_check::{ByRows, RowCheck};
 use crate::particle::transfer::NodeBox;
 use crate::scalar::Real;
 use rand::{Rng, SeedableRng};
@@ -31,7 +31,7 @@ struct Check<'a, T> {
 
 impl<T: Real> Check<'_, T> {
     /// Compares per chunk of eight positions, on both layouts.
-    fn rows<R: Lane<Scalar = T>, const K: usize>(&mut self) {
+    fn rows_on<R: Lane<Scalar = T>, const K: usize>(&mut self) {
         let n = CELLS as i32;
         let nodes = NodeBox {
             lo: [0; 3],
@@ -70,67 +70,41 @@ impl<T: Real> Check<'_, T> {
         rel: &[[isize; 3]; LANES],
         ch: &[InChannel<T, 3>; 3],
     ) {
+        // The pair (new, old) from components 0 and 1: values of mixed magnitudes, so that
+        // their differences round too.
         let z = R::splat(T::ZERO);
-        let mut prods = [[[z; LANES]; 2]; MAX_OUT];
+        let mut prods = [z; LANES];
         for k in 0..LANES {
-            let (p, ok) = node_field_products::<T, R, 3, K>(&s[k], &rel[k], ch);
+            let (p, ok) = pair_products::<T, R, 3, K>(&s[k], &rel[k], &ch[0], &ch[1]);
             assert!(ok);
-            for (pq, x) in prods.iter_mut().zip(&p) {
-                for j in 0..2 {
-                    pq[j][k] = x[j];
-                }
-            }
+            prods[k] = p;
         }
-        // got[q][a][k]: output `q`, component `a`, particle `k`.
-        let mut got = [[[T::ZERO; LANES]; 3]; MAX_OUT];
-        for (gq, pq) in got.iter_mut().zip(&prods).take(7) {
-            for j in 0..2 {
-                let sums = chunk_sums::<R, K>(pq[j]);
-                sums[0].store(&mut gq[2 * j]);
-                if j == 0 {
-                    sums[1].store(&mut gq[1]);
-                }
-            }
+        let mut got = [[T::ZERO; LANES]; 2];
+        for (g, x) in got.iter_mut().zip(chunk_sums::<R, K>(prods)) {
+            x.store(g);
         }
         for k in 0..LANES {
-            let want = node_field_sums::<T, R, 3, K, true>(&s[k], &rel[k], ch, (0, 3));
-            assert!(want.finite);
-            for a in 0..3 {
-                let mut w = std::vec![];
-                for b in 0..3 {
-                    w.push(want.g.cols[b][a]);
-                }
-                w.push(want.v[a]);
-                for b in 0..3 {
-                    w.push(want.mo.cols[b][a]);
-                }
-                for (q, wq) in w.iter().enumerate() {
-                    assert_eq!(
-                        got[q][a][k].to_f64().to_bits(),
-                        wq.to_f64().to_bits(),
-                        "{} lanes, K = {K}: output {q} component {a} particle {k}",
-                        R::LANES
-                    );
-                }
+            let (pic, flip, ok) = pair_sums::<T, R, 3, K>(&s[k], &rel[k], &ch[0], &ch[1]);
+            assert!(ok);
+            for (q, want) in [pic, flip].iter().enumerate() {
+                assert_eq!(
+                    got[q][k].to_f64().to_bits(),
+                    want.to_f64().to_bits(),
+                    "{} lanes, K = {K}: output {q} particle {k}",
+                    R::LANES
+                );
             }
         }
     }
 }
 
-impl<T: Real> LaneOp<T> for Check<'_, T> {
-    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        BatchStatus {
-            first_failed: 0,
-            error: None,
-        }
+impl<T: Real> RowCheck<T> for Check<'_, T> {
+    fn kernel(&self) -> Kernel {
+        self.kernel
     }
 
-    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        match self.kernel {
-            Kernel::Quadratic => self.rows::<R, 3>(),
-            Kernel::Cubic => self.rows::<R, 4>(),
-        }
-        self.run::<V>()
+    fn rows<R: Lane<Scalar = T>, const K: usize>(&mut self) {
+        self.rows_on::<R, K>();
     }
 }
 
@@ -161,7 +135,7 @@ fn compare<T: BatchReal>() {
                 xs: &xs,
                 done: 0,
             };
-            dispatch::<T, _>(isa, &mut c);
+            dispatch::<T, _>(isa, &mut ByRows(&mut c));
             total += c.done;
         }
     }
@@ -169,11 +143,11 @@ fn compare<T: BatchReal>() {
 }
 
 #[test]
-fn chunk_sums_give_each_particles_sums_f32() {
+fn chunk_pair_sums_give_each_particles_sums_f32() {
     compare::<f32>();
 }
 
 #[test]
-fn chunk_sums_give_each_particles_sums_f64() {
+fn chunk_pair_sums_give_each_particles_sums_f64() {
     compare::<f64>();
 }
