@@ -463,7 +463,7 @@ unsafe fn sample_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: us
         }
     }
     // The velocity sums after the temperatures' (measured faster in this order).
-    let sm = chunk_field_sums::<T, R, D, K, true>(stencils, &rel, live, &view.velocity);
+    let sm = chunk_field_sums::<T, R, D, K>(stencils, &rel, live, &view.velocity);
     // The stencils' `fx` by axis, particle `l` in lane `l` (records of a stencil's size).
     let mut fx = [z; 3];
     debug_assert!(size_of::<Stencil<T, D>>() % size_of::<T>() == 0);

@@ -23,7 +23,6 @@
 use super::field_sums::first_node;
 use super::InChannel;
 use crate::lane::Lane;
-use crate::mat::Mat;
 use crate::particle::stencil::Stencil;
 use crate::scalar::Real;
 
@@ -77,8 +76,7 @@ impl<T: Real, L: Lane<Scalar = T>> LaneWeights<L> {
 
 /// The [`LaneSums`] of the field `ch` (components `0..d`) for the lanes' stencils with weights
 /// `wt`: `first[a][l]` is lane `l`'s first stencil node in channel `a` (node offset 0 on every
-/// axis), in the order of the module docs; `FULL`: also `Σ w u` and the moments (else those
-/// are 0).
+/// axis), in the order of the module docs.
 ///
 /// # Safety
 /// Every node of every lane's stencil is valid for reading in each channel.
@@ -88,7 +86,6 @@ pub(super) unsafe fn lane_field_sums<
     L: Lane<Scalar = T>,
     const D: usize,
     const K: usize,
-    const FULL: bool,
 >(
     wt: &LaneWeights<L>,
     ch: &[InChannel<T, D>; D],
@@ -142,13 +139,11 @@ pub(super) unsafe fn lane_field_sums<
                     zs = u[o0].mul_add(z, zs);
                     sw = u[o0].mul_add(w[0][o0], sw);
                     sd = u[o0].mul_add(dw[0][o0], sd);
-                    if FULL {
-                        so = if o0 == 1 {
-                            u[o0] * w0o[o0]
-                        } else {
-                            u[o0].mul_add(w0o[o0], so)
-                        };
-                    }
+                    so = if o0 == 1 {
+                        u[o0] * w0o[o0]
+                    } else {
+                        u[o0].mul_add(w0o[o0], so)
+                    };
                 }
                 chk[a] += zs;
                 s.g[0][a] = c.mul_add(sd, s.g[0][a]);
@@ -156,15 +151,13 @@ pub(super) unsafe fn lane_field_sums<
                 if D == 3 {
                     s.g[D - 1][a] = c2.mul_add(sw, s.g[D - 1][a]);
                 }
-                if FULL {
-                    s.v[a] = c.mul_add(sw, s.v[a]);
-                    s.mo[0][a] = c.mul_add(so, s.mo[0][a]);
-                    if o1 > 0 {
-                        s.mo[1][a] = (c * o[o1]).mul_add(sw, s.mo[1][a]);
-                    }
-                    if D == 3 && o2 > 0 {
-                        s.mo[D - 1][a] = (c * o[o2]).mul_add(sw, s.mo[D - 1][a]);
-                    }
+                s.v[a] = c.mul_add(sw, s.v[a]);
+                s.mo[0][a] = c.mul_add(so, s.mo[0][a]);
+                if o1 > 0 {
+                    s.mo[1][a] = (c * o[o1]).mul_add(sw, s.mo[1][a]);
+                }
+                if D == 3 && o2 > 0 {
+                    s.mo[D - 1][a] = (c * o[o2]).mul_add(sw, s.mo[D - 1][a]);
                 }
             }
         }
@@ -185,7 +178,6 @@ pub(super) unsafe fn chunk_field_sums<
     L: Lane<Scalar = T>,
     const D: usize,
     const K: usize,
-    const FULL: bool,
 >(
     stencils: &[Stencil<T, D>; LANES],
     rel: &[[isize; D]; LANES],
@@ -213,24 +205,7 @@ pub(super) unsafe fn chunk_field_sums<
         }
     }
     let wt = LaneWeights::<L>::of::<D, K>(stencils);
-    lane_field_sums::<T, L, D, K, FULL>(&wt, ch, &first)
-}
-
-/// Lane `l` of every vector of `g` as a matrix (`cols[b][a]` from `g[b][a]`).
-#[inline(always)]
-pub(super) fn lane_mat<T: Real, L: Lane<Scalar = T>, const D: usize>(
-    g: &[[L; D]; D],
-    l: usize,
-) -> Mat<T, D> {
-    let mut m = Mat::<T, D>::ZERO;
-    let mut b = [T::ZERO; 16];
-    for (col, gc) in m.cols.iter_mut().zip(g) {
-        for (x, v) in col.iter_mut().zip(gc) {
-            v.store(&mut b);
-            *x = b[l];
-        }
-    }
-    m
+    lane_field_sums::<T, L, D, K>(&wt, ch, &first)
 }
 
 #[cfg(test)]

@@ -8,7 +8,7 @@ use crate::lane::{Isa, Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
 use crate::particle::implicit::{apply_entries, apply_slot, slot_len, tag};
 use crate::particle::stencil::{Grid, Kernel, Stencil};
-use crate::particle::transfer::lane_sums::{chunk_field_sums, lane_mat, LaneSums};
+use crate::particle::transfer::field_sums::node_field_sums;
 use crate::particle::transfer::nodes::{add, nodes, rel_base, restore, table, with_nodes};
 use crate::particle::transfer::tile::{axis0, set_grad, Coef, Tile, MAX_RUN, TILE_X};
 use crate::particle::transfer::{chunk_stencils, rd_vec, BatchStatus, FirstFailure};
@@ -103,11 +103,11 @@ where
     /// `δf` goes into a node tile ([`crate::particle::transfer::tile`]) that is added to `df` per run of nearby
     /// particles; a run whose sum would not be finite is added again one particle at a time
     /// ([`one`]), which refuses the particles that overflow. Particles go in chunks of
-    /// [`TILE_X`]: the chunk's stencils on lanes, each particle's checks, the chunk's `G`
-    /// (reads of `δu`) one particle per lane ([`grad_u_lanes`]), then its `M = 𝒜(G)`
-    /// ([`apply_entries`] on lanes when every particle of a full chunk got its `G`, one by one
-    /// otherwise: the same formulas, whose multiply-adds are fused on the vector instruction
-    /// sets), then the tile (writes of `δf`, which no read of `δu` sees).
+    /// [`TILE_X`]: the chunk's stencils on lanes, then each particle's `G` (reads of `δu`,
+    /// written in place), then the chunk's `M = 𝒜(G)` ([`apply_entries`] on lanes when every
+    /// particle of a full chunk got its `G`, one by one otherwise: the same formulas, whose
+    /// multiply-adds are fused on the vector instruction sets), then the tile (writes of
+    /// `δf`, which no read of `δu` sees).
     #[inline(always)]
     fn run_nodes<R: Lane<Scalar = T>, Q: Pair<R>, const K: usize, const N: usize>(
         &mut self,
@@ -121,6 +121,7 @@ where
         let mut xs = [[T::ZERO; D]; TILE_X];
         let mut stencils = [Stencil::blank(kernel, h); TILE_X];
         let mut rels = [[0isize; D]; TILE_X];
+        let mut gs = [Mat::<T, D>::ZERO; TILE_X];
         let mut ms = [Mat::<T, D>::ZERO; TILE_X];
         let mut live = [false; TILE_X];
         let sl = slot_len(D);
@@ -131,50 +132,33 @@ where
             let done = unsafe {
                 chunk_stencils::<T, R, D>(kernel, h, self.x, (start, len), &mut xs, &mut stencils)
             };
-            // Each particle's checks (slot, stencil, box), then `G` of the chunk on lanes.
-            let mut ok = 0u32;
             for k in 0..len {
                 // SAFETY: as above.
                 let r = unsafe {
-                    self.check::<K>(
+                    self.gather_with::<R, K, N>(
                         start + k,
                         &xs[k],
                         done >> k & 1 == 1,
                         &mut stencils[k],
                         &mut rels[k],
+                        &mut gs[k],
                     )
                 };
-                ok |= u32::from(r.is_ok()) << k;
+                live[k] = r.is_ok();
                 first.note(start + k, r);
             }
-            if ok != 0 {
-                // SAFETY: as above; the stencils of the lanes in `ok` are inside the box.
-                let g = unsafe { grad_u_lanes::<T, R, D, K>(&stencils, &rels, ok, self.view) };
-                let bad = !R::mask_bits(g.chk.is_finite());
-                for (k, l) in live.iter_mut().enumerate() {
-                    *l = k < len && ok >> k & 1 == 1;
-                    if *l && bad >> k & 1 == 1 {
-                        *l = false;
-                        first.note(start + k, Err(Error::NonFinite));
-                    }
-                }
-                if len == TILE_X && live.iter().all(|&l| l) {
-                    // SAFETY: `apply`'s contract: slots `start..start + TILE_X` of `n`; `ms`
-                    // is `repr(C)` matrices of `d²` scalars each.
-                    unsafe {
-                        apply_chunk::<T, R, D>(self.slots.add(start * sl), sl, &g.g, &mut ms)
-                    };
-                } else {
-                    for (k, m) in ms.iter_mut().enumerate().take(len) {
-                        if live[k] {
-                            // SAFETY: `apply`'s contract; a live particle's slot was checked.
-                            let slot = unsafe { self.slot(start + k) };
-                            *m = apply_slot(slot, &lane_mat(&g.g, k));
-                        }
-                    }
-                }
+            if len == TILE_X && live.iter().all(|&l| l) {
+                // SAFETY: `apply`'s contract: slots `start..start + TILE_X` of `n`; `gs` and
+                // `ms` are `repr(C)` matrices of `d²` scalars each.
+                unsafe { apply_chunk::<T, R, D>(self.slots.add(start * sl), sl, &gs, &mut ms) };
             } else {
-                live = [false; TILE_X];
+                for k in 0..len {
+                    if live[k] {
+                        // SAFETY: `apply`'s contract; a live particle's slot was checked.
+                        let slot = unsafe { self.slot(start + k) };
+                        ms[k] = apply_slot(slot, &gs[k]);
+                    }
+                }
             }
             for k in 0..len {
                 if live[k] {
@@ -235,25 +219,20 @@ where
         *nrun += 1;
     }
 
-    /// Particle `i`'s stencil, box-relative base and `M = 𝒜(G)`, with `G` from the lanes'
-    /// sums (every lane particle `i`): the bits of `G` in its chunk.
+    /// Particle `i`'s stencil, box-relative base and `M = 𝒜(G)`.
     ///
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn gather<R: Lane<Scalar = T>, const K: usize>(
+    unsafe fn gather<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
         i: usize,
     ) -> Result<(Stencil<T, D>, [isize; D], Mat<T, D>)> {
         let xp = rd_vec::<T, D>(self.x, i);
         let mut s = Stencil::blank(self.kernel, self.h);
-        let mut rel = [0; D];
-        self.check::<K>(i, &xp, false, &mut s, &mut rel)?;
-        let g = grad_u_lanes::<T, R, D, K>(&[s; TILE_X], &[rel; TILE_X], 1, self.view);
-        if !R::all(g.chk.is_finite()) {
-            return Err(Error::NonFinite);
-        }
-        Ok((s, rel, apply_slot(self.slot(i), &lane_mat(&g.g, 0))))
+        let (mut rel, mut g) = ([0; D], Mat::ZERO);
+        self.gather_with::<R, K, N>(i, &xp, false, &mut s, &mut rel, &mut g)?;
+        Ok((s, rel, apply_slot(self.slot(i), &g)))
     }
 
     /// Particle `i`'s slot.
@@ -266,20 +245,23 @@ where
         core::slice::from_raw_parts(self.slots.add(i * sl), sl)
     }
 
-    /// The checks of particle `i` at `xp` before its `G`, in this order: its slot, its
-    /// stencil (into `s`; with `lane`, `s` already holds the stencil of `xp`,
-    /// [`Stencil::new_lanes`]), the box (its box-relative base into `rel`).
+    /// [`Self::gather`] of particle `i` at `xp` into `s`, `rel` and `G` (in part on error; built
+    /// in place, for the reason given at [`crate::particle::transfer::Particles::read_into`]); with `lane`, `s`
+    /// already holds the stencil of `xp` ([`Stencil::new_lanes`]). Statuses in the order of
+    /// the checks: slot, stencil, box, `δu`.
     ///
     /// # Safety
     /// `apply`'s contract.
     #[inline(always)]
-    unsafe fn check<const K: usize>(
+    #[allow(clippy::too_many_arguments)]
+    unsafe fn gather_with<R: Lane<Scalar = T>, const K: usize, const N: usize>(
         &self,
         i: usize,
         xp: &[T; D],
         lane: bool,
         s: &mut Stencil<T, D>,
         rel: &mut [isize; D],
+        g: &mut Mat<T, D>,
     ) -> Result<()> {
         if self.slot(i)[0] != tag::<T>(D) {
             return Err(Error::NotPrepared);
@@ -288,6 +270,7 @@ where
             *s = Stencil::new(self.kernel, Grid::Collocated, self.h, xp)?;
         }
         *rel = rel_base(s, &self.view.nodes)?;
+        *g = grad_u::<T, R, D, K, N>(s, rel, self.view)?;
         Ok(())
     }
 
@@ -308,7 +291,7 @@ where
         }
         for &i in run {
             let r = self
-                .gather::<R, K>(i)
+                .gather::<R, K, N>(i)
                 .and_then(|(s, rel, m)| one::<T, D, K, N>(&s, &rel, &m, self.view));
             first.note(i, r);
         }
@@ -316,8 +299,7 @@ where
 }
 
 /// `M = 𝒜(G)` of [`TILE_X`] consecutive particles on lanes ([`apply_entries`]): `slots` the
-/// first one's slot (each `sl` scalars), `g` their `G` (particle `l` in lane `l`, `g[j][i]`
-/// entry `(i, j)`), `ms` their `M`.
+/// first one's slot (each `sl` scalars), `gs` their `G`, `ms` their `M`.
 ///
 /// # Safety
 /// `slots` is valid for reading `TILE_X·sl` scalars.
@@ -325,7 +307,7 @@ where
 unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
     slots: *const T,
     sl: usize,
-    g: &[[R; D]; D],
+    gs: &[Mat<T, D>; TILE_X],
     ms: &mut [Mat<T, D>; TILE_X],
 ) {
     debug_assert_eq!(R::LANES, TILE_X);
@@ -333,32 +315,42 @@ unsafe fn apply_chunk<T: Real, R: Lane<Scalar = T>, const D: usize>(
     // Slot entries 1.. (after the tag): at most those of a 3D slot.
     let mut e = [z; slot_len(3) - 1];
     R::load_records(slots.add(1), sl, &mut e[..sl - 1]);
-    let m = apply_entries::<R, D>(&e[..sl - 1], g);
     // `Mat` is `repr(C)` around `[[T; D]; D]`: entry (i, j) of particle `l` is scalar
-    // `l·d² + j·d + i` of the array.
+    // `l·d² + j·d + i` of the arrays.
+    let (gp, mp) = (gs.as_ptr().cast::<T>(), ms.as_mut_ptr().cast::<T>());
     let mut flat = [z; 9];
+    R::load_records(gp, D * D, &mut flat[..D * D]);
+    let mut g = [[z; D]; D];
+    for (j, col) in g.iter_mut().enumerate() {
+        for (i, x) in col.iter_mut().enumerate() {
+            *x = flat[j * D + i];
+        }
+    }
+    let m = apply_entries::<R, D>(&e[..sl - 1], &g);
     for (j, col) in m.iter().enumerate() {
         for (i, x) in col.iter().enumerate() {
             flat[j * D + i] = *x;
         }
     }
-    R::store_records(ms.as_mut_ptr().cast::<T>(), D * D, &flat[..D * D]);
+    R::store_records(mp, D * D, &flat[..D * D]);
 }
 
-/// `G = Σ_j δu_j ∇w_jᵀ` of the chunk's particles in `live` (their stencils inside the box at
-/// `rel`), one per lane ([`chunk_field_sums`]); `chk` not finite in a lane that read a `δu` that
-/// is not finite.
+/// `G = Σ_j δu_j ∇w_jᵀ` over the nodes of stencil `s` (box-relative base `rel`), by the
+/// separable contraction of [`node_field_sums`].
 ///
 /// # Safety
-/// `apply`'s contract; the stencils of the lanes in `live` are inside the box.
+/// `apply`'s contract; the stencil is inside the box.
 #[inline(always)]
-unsafe fn grad_u_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
-    stencils: &[Stencil<T, D>; TILE_X],
-    rel: &[[isize; D]; TILE_X],
-    live: u32,
+unsafe fn grad_u<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize, const N: usize>(
+    s: &Stencil<T, D>,
+    rel: &[isize; D],
     view: &ForceView<T, D>,
-) -> LaneSums<R, D> {
-    chunk_field_sums::<T, R, D, K, false>(stencils, rel, live, &view.du)
+) -> Result<Mat<T, D>> {
+    let sums = node_field_sums::<T, R, D, K, false>(s, rel, &view.du, (0, D));
+    if !sums.finite {
+        return Err(Error::NonFinite);
+    }
+    Ok(sums.g)
 }
 
 /// One particle of [`apply()`] added on its own: `δf_i = M ∇w_i` added per channel, with every

@@ -100,7 +100,7 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
             }
         }
         let wt = LaneWeights::<L>::of::<D, K>(&s);
-        (lane_field_sums::<T, L, D, K, true>(&wt, ch, &first), s)
+        (lane_field_sums::<T, L, D, K>(&wt, ch, &first), s)
     }
 
     fn rows_on<L: Lane<Scalar = T>, const K: usize>(&mut self) {
