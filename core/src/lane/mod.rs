@@ -102,19 +102,7 @@ pub trait Lane:
     #[inline(always)]
     #[must_use]
     unsafe fn load_rows<const K: usize>(p: &[*const Self::Scalar], s0: isize) -> [Self; 4] {
-        debug_assert!(K <= 4 && p.len() == Self::LANES && Self::LANES <= 16);
-        let mut b = [[Self::Scalar::ZERO; 16]; 4];
-        for (i, q) in p.iter().enumerate() {
-            for (o, bo) in b.iter_mut().enumerate().take(K) {
-                bo[i] = q.offset(o as isize * s0).read_unaligned();
-            }
-        }
-        [
-            Self::load(&b[0]),
-            Self::load(&b[1]),
-            Self::load(&b[2]),
-            Self::load(&b[3]),
-        ]
+        load_rows_scalar::<Self, K>(p, s0)
     }
     /// Structure-of-arrays view of `LANES` consecutive records of `rec` scalars: `out[c]`
     /// lane `i` is `*base.add(i·rec + c)` for `c < out.len() ≤ rec` (a particle array of
@@ -353,6 +341,31 @@ impl<R: Lane> Pair<R> for X2<R> {
 
 /// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
 /// (`libm`), so this is also what `no_std` targets run.
+
+/// [`Lane::load_rows`] by scalar reads (any axis-0 stride `s0`): its default, and the strided
+/// case of the types that override it.
+///
+/// # Safety
+/// As [`Lane::load_rows`].
+#[inline(always)]
+pub(crate) unsafe fn load_rows_scalar<L: Lane, const K: usize>(
+    p: &[*const L::Scalar],
+    s0: isize,
+) -> [L; 4] {
+    debug_assert!(K <= 4 && p.len() == L::LANES && L::LANES <= 16);
+    let mut b = [[L::Scalar::ZERO; 16]; 4];
+    for (i, q) in p.iter().enumerate() {
+        for (o, bo) in b.iter_mut().enumerate().take(K) {
+            bo[i] = q.offset(o as isize * s0).read_unaligned();
+        }
+    }
+    [
+        L::load(&b[0]),
+        L::load(&b[1]),
+        L::load(&b[2]),
+        L::load(&b[3]),
+    ]
+}
 
 /// [`Lane::quad_sums`] through memory: each vector stored, its groups summed as scalars.
 #[inline(always)]

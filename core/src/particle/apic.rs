@@ -62,7 +62,7 @@ pub fn inv_moment<T: Real>(kernel: Kernel, h: T) -> Result<T> {
 /// Errors: as [`inv_moment`] (a positive finite `h` has `1/(κ h) > 0`, so only inf
 /// overflows).
 #[inline]
-fn inv_kappa_h<T: Real>(kernel: Kernel, h: T) -> Result<T> {
+pub(crate) fn inv_kappa_h<T: Real>(kernel: Kernel, h: T) -> Result<T> {
     if !h.is_finite() {
         return Err(Error::NonFinite);
     }

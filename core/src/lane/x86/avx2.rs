@@ -2,7 +2,7 @@
 
 #![allow(clippy::cast_possible_truncation, clippy::cast_sign_loss)]
 
-use super::super::Lane;
+use super::super::{load_rows_scalar, Lane};
 use super::records::{load_records8, store_records8, transpose8};
 use core::arch::x86_64::*;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
@@ -123,18 +123,7 @@ impl Lane for F32x8 {
     unsafe fn load_rows<const K: usize>(p: &[*const f32], s0: isize) -> [Self; 4] {
         debug_assert!(K <= 4 && p.len() == 8);
         if s0 != 1 {
-            let mut b = [[0.0f32; 8]; 4];
-            for (i, q) in p.iter().enumerate() {
-                for (o, bo) in b.iter_mut().enumerate().take(K) {
-                    bo[i] = q.offset(o as isize * s0).read_unaligned();
-                }
-            }
-            return [
-                Self::load(&b[0]),
-                Self::load(&b[1]),
-                Self::load(&b[2]),
-                Self::load(&b[3]),
-            ];
+            return load_rows_scalar::<Self, K>(p, s0);
         }
         // Row `i` in lanes 0..4 of a 128-bit load (lanes `K..4` masked off: not read), rows `i`
         // and `i + 4` in the two halves of one vector, then a 4 × 4 transpose within each half:

@@ -20,6 +20,7 @@ use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
+use crate::particle::apic::inv_kappa_h;
 use crate::particle::stencil::{Grid, Kernel, Stencil};
 use crate::particle::update::{update_validated, G2pSample};
 use crate::particle::Material;
@@ -337,10 +338,7 @@ where
         [0; D]
     };
     // 1/(κ h): C_p = (Σ w v oᵀ − v fxᵀ)/(κ h).
-    let inv_kh = T::ONE / (args.kernel.apic_moment::<T>() * args.h);
-    if !inv_kh.is_finite() {
-        return Err(Error::Overflow);
-    }
+    let inv_kh = inv_kappa_h(args.kernel, args.h)?;
     out.t_pic = T::ZERO;
     out.t_flip = T::ZERO;
     let mut finite = true;
@@ -417,15 +415,18 @@ unsafe fn sample_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: us
     if live == 0 {
         return;
     }
-    let inv_kh = T::ONE / (args.kernel.apic_moment::<T>() * args.h);
-    if !inv_kh.is_finite() {
-        for (k, st) in status.iter_mut().enumerate() {
-            if live >> k & 1 == 1 {
-                *st = Err(Error::Overflow);
+    // `1/(κ h)` (a lane with a stencil has a finite positive `h`: only an overflow is left).
+    let inv_kh = match inv_kappa_h(args.kernel, args.h) {
+        Ok(x) => x,
+        Err(e) => {
+            for (k, st) in status.iter_mut().enumerate() {
+                if live >> k & 1 == 1 {
+                    *st = Err(e);
+                }
             }
+            return;
         }
-        return;
-    }
+    };
     let z = R::splat(T::ZERO);
     // Lanes that read a temperature that is not finite.
     let mut heat_bad = 0u64;
