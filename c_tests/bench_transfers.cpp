@@ -4,6 +4,8 @@
 //   bench_transfers [--out FILE] [--reps R]   time every case, markdown table to stdout and FILE
 //                                             (default docs/bench-transfers.md)
 //   bench_transfers --check                   tiny sizes, agreement checks only (for ctest)
+//   bench_transfers --ab A.so B.so [--reps R] two builds of libampm.so, loaded with dlopen, timed
+//                                             alternately call by call (A/B comparison)
 //
 // Workload (fixed seed): a block of particles, 2 per cell per axis (spacing h/2, jittered by
 // ±h/8), 38³ = 54,872 particles in 3D and 234² = 54,756 in 2D, h = 1 cm, quadratic B-splines,
@@ -47,6 +49,16 @@
 // the medians is reported (≈ 1.00 when the wrapper costs nothing). Before timing, and in
 // --check, the wrapper's step must give bit-identical grids and particles to the C step.
 //
+// --ab: two builds of the library (say, before and after a change) in one process, each
+// loaded from its own libampm.so with dlopen (its own copy of the library's state). For every
+// scene but snow, 3D and 2D f32, every instruction set both accept: lib (P2G sym + G2P, each
+// build its own P2G, grid update and G2P) and apply (zeroing df + apply, after an untimed
+// prepare), the two builds alternating rep by rep (which goes first alternates too), so that
+// both see the same machine state; medians of R reps (default 31) and the ratio B / A. A
+// change of a few percent, below the spread between separate runs of the benchmark, shows
+// in the ratio. Both builds must return AMPM_OK and the same grids and particles, bit for bit
+// (a performance change must not change results; the check runs before timing).
+//
 // --check (and every timing run, before timing): on tiny blocks (6³, 14²), every call returns
 // AMPM_OK with first_failed = n and finite results; for the elastic scene the library's and the
 // baseline's P2G grids and G2P particles agree with the same loop evaluated in long double
@@ -63,6 +75,8 @@
 
 #include "ampm.hpp"
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -77,6 +91,8 @@
 #include <sstream>
 #include <string>
 #include <thread>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "bench_floor.hpp"
@@ -1403,10 +1419,178 @@ Floor time_floor(int per_axis, int reps, double fma_per_ns) {
   return f;
 }
 
+// ---- A/B: two builds of the library, alternately -------------------------------------------
+
+/// One build of the library, loaded with dlopen (RTLD_LOCAL: its own symbols and state).
+struct AbLib {
+  std::string path;
+  void* handle = nullptr;
+  AmpmStatus (*set_isa)(std::uint32_t) = nullptr;
+
+  explicit AbLib(std::string p) : path(std::move(p)) {
+    handle = dlopen(path.c_str(), RTLD_NOW | RTLD_LOCAL);
+    if (handle == nullptr) fail("dlopen " + path + ": " + dlerror());
+    set_isa = sym<AmpmStatus (*)(std::uint32_t)>("ampm_set_isa");
+  }
+  AbLib(const AbLib&) = delete;
+  AbLib& operator=(const AbLib&) = delete;
+  template <class F>
+  F sym(const std::string& name) const {
+    void* f = dlsym(handle, name.c_str());
+    if (f == nullptr) fail(path + " has no symbol " + name);
+    return reinterpret_cast<F>(f);
+  }
+};
+
+/// The calls of one build for `Api<T, D>`, resolved by name.
+template <class T, int D>
+struct AbFns {
+  using A = Api<T, D>;
+  std::remove_const_t<decltype(A::p2g)> p2g;
+  std::remove_const_t<decltype(A::g2p)> g2p;
+  std::remove_const_t<decltype(A::prepare)> prepare;
+  std::remove_const_t<decltype(A::apply)> apply;
+
+  explicit AbFns(const AbLib& l) {
+    const std::string s = std::string(std::is_same<T, float>::value ? "f32" : "f64");
+    const std::string d = std::to_string(D) + "d_";
+    p2g = l.sym<decltype(p2g)>("ampm_p2g_" + d + s);
+    g2p = l.sym<decltype(g2p)>("ampm_g2p_update_" + d + s);
+    prepare = l.sym<decltype(prepare)>("ampm_force_prepare_" + d + s);
+    apply = l.sym<decltype(apply)>("ampm_force_apply_" + d + s);
+  }
+};
+
+/// One A/B row: medians (ns per particle) of both builds.
+struct AbRow {
+  std::string scene, kase, isa;
+  double lib[2] = {NAN, NAN}, apply[2] = {NAN, NAN};
+};
+
+/// Times one case on instruction set `isa` with both builds alternately (see the header).
+template <class T, int D>
+void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* libs[2], std::vector<AbRow>& rows) {
+  for (int k = 0; k < 2; ++k)
+    if (libs[k]->set_isa(isa) != AMPM_OK) return;
+  Case<T, D> cs(s, per_axis);
+  const AbFns<T, D> fns[2] = {AbFns<T, D>(*libs[0]), AbFns<T, D>(*libs[1])};
+  const std::size_t n = cs.p.n;
+  std::size_t ff = 0;
+  const auto m = material<T, D>(s, false);
+  const auto mp = material<T, D>(s, true);
+  auto check = [&](int k, const char* what, AmpmStatus st) {
+    expect_ok(cs.label(what) + " (" + libs[k]->path + ")", st, ff, n);
+  };
+  auto p2g = [&](int k) {
+    auto pv = cs.p.view();
+    check(k, "P2G sym", fns[k].p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, cs.h, cs.dt, n, &pv, &cs.v.sym, &ff));
+  };
+  auto g2p = [&](int k) {
+    auto pv = cs.p.view();
+    check(k, "G2P", fns[k].g2p(&m, AMPM_KERNEL_QUADRATIC, cs.h, cs.dt, n, &pv, &cs.v.g2p, &ff));
+  };
+  auto prepare = [&](int k) {
+    auto pv = cs.p.view();
+    check(k, "prepare", fns[k].prepare(&mp, n, &pv, cs.slots.data(), &ff));
+  };
+  auto apply = [&](int k) {
+    cs.zero_df();
+    check(k, "apply", fns[k].apply(AMPM_KERNEL_QUADRATIC, cs.h, n, cs.p.x.data(), cs.slots.data(), &cs.v.force, &ff));
+  };
+  auto clock = [] { return std::chrono::steady_clock::now(); };
+  auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
+  // Results first: the same grids, particles and forces from both builds, bit for bit.
+  std::vector<T> grid[2], parts[2], df[2];
+  for (int k = 0; k < 2; ++k) {
+    cs.restore();
+    cs.g.zero_p2g();
+    p2g(k);
+    grid[k] = cs.g.mass;
+    for (int a = 0; a < D; ++a) grid[k].insert(grid[k].end(), cs.g.mom[a].begin(), cs.g.mom[a].end());
+    grid_update(cs.g, cs.thermal);
+    g2p(k);
+    parts[k] = cs.p.x;
+    parts[k].insert(parts[k].end(), cs.p.v.begin(), cs.p.v.end());
+    parts[k].insert(parts[k].end(), cs.p.c.begin(), cs.p.c.end());
+    parts[k].insert(parts[k].end(), cs.p.fe.begin(), cs.p.fe.end());
+    parts[k].insert(parts[k].end(), cs.p.t.begin(), cs.p.t.end());
+    cs.restore();
+    prepare(k);
+    apply(k);
+    for (int a = 0; a < D; ++a) df[k].insert(df[k].end(), cs.g.df[a].begin(), cs.g.df[a].end());
+  }
+  auto same = [](const std::vector<T>& a, const std::vector<T>& b) {
+    return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
+  };
+  if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(df[0], df[1]))
+    fail(cs.label("results") + " on " + isa_name(isa) + ": the two builds differ");
+  std::vector<double> lib[2], app[2];
+  for (int r = -1; r < reps; ++r) {
+    for (int j = 0; j < 2; ++j) {
+      const int k = (r + j + 2) % 2;
+      cs.restore();
+      cs.g.zero_p2g();
+      const auto t0 = clock();
+      p2g(k);
+      const auto t1 = clock();
+      grid_update(cs.g, cs.thermal);
+      const auto t2 = clock();
+      g2p(k);
+      const auto t3 = clock();
+      cs.restore();
+      prepare(k);
+      const auto t4 = clock();
+      apply(k);
+      const auto t5 = clock();
+      if (r >= 0) lib[k].push_back(ns(t0, t1) + ns(t2, t3)), app[k].push_back(ns(t4, t5));
+    }
+  }
+  cs.restore();
+  auto median = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  AbRow row;
+  row.scene = scene_name(s), row.kase = Api<T, D>::name, row.isa = isa_name(isa);
+  for (int k = 0; k < 2; ++k) row.lib[k] = median(lib[k]), row.apply[k] = median(app[k]);
+  std::fprintf(stderr, "%-14s %s %-8s lib %6.1f / %6.1f (%.3f)  apply %6.1f / %6.1f (%.3f)\n", row.scene.c_str(),
+               row.kase.c_str(), row.isa.c_str(), row.lib[0], row.lib[1], row.lib[1] / row.lib[0], row.apply[0],
+               row.apply[1], row.apply[1] / row.apply[0]);
+  rows.push_back(row);
+}
+
+/// The A/B comparison (--ab): a markdown table of both builds' medians and their ratio.
+int run_ab(const std::string& a, const std::string& b, int reps) {
+  const AbLib la(a), lb(b);
+  const AbLib* libs[2] = {&la, &lb};
+  std::vector<AbRow> rows;
+  for (Scene s : {Scene::Elastic, Scene::Fluid, Scene::Thermal})
+    for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}}) {
+      ab_case<float, 3>(s, 38, reps, isa, libs, rows);
+      ab_case<float, 2>(s, 234, reps, isa, libs, rows);
+    }
+  std::ostringstream o;
+  o << "A/B (bench_transfers --ab, " << reps << " reps, alternating): A = `" << a << "`, B = `" << b << "`\n"
+    << "CPU: " << cpu_model() << "; load before: " << load_average() << "\n\n"
+    << "| scene | case | ISA | lib A | lib B | B / A | apply A | apply B | B / A |\n|---|---|---|---|---|---|---|---|---|\n";
+  char buf[64];
+  auto num = [&](double x, const char* f) {
+    std::snprintf(buf, sizeof buf, f, x);
+    return std::string(buf);
+  };
+  for (const AbRow& r : rows)
+    o << "| " << r.scene << " | " << r.kase << " | " << r.isa << " | " << num(r.lib[0], "%.1f") << " | "
+      << num(r.lib[1], "%.1f") << " | " << num(r.lib[1] / r.lib[0], "%.3f") << " | " << num(r.apply[0], "%.1f")
+      << " | " << num(r.apply[1], "%.1f") << " | " << num(r.apply[1] / r.apply[0], "%.3f") << " |\n";
+  std::fputs(o.str().c_str(), stdout);
+  return 0;
+}
+
 [[noreturn]] void usage(int code) {
   std::fprintf(code == 0 ? stdout : stderr,
                "usage: bench_transfers [--out FILE] [--reps R]   time every case (default FILE docs/bench-transfers.md)\n"
-               "       bench_transfers --check                   agreement checks only, tiny sizes\n");
+               "       bench_transfers --check                   agreement checks only, tiny sizes\n"
+               "       bench_transfers --ab A.so B.so [--reps R] two builds of libampm.so timed alternately\n");
   std::exit(code);
 }
 
@@ -1417,16 +1601,22 @@ int main(int argc, char** argv) {
   int reps = kDefaultReps;
   std::string out = "docs/bench-transfers.md";
   bool out_given = false;
+  std::string ab[2];
+  bool reps_given = false;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--check") {
       check = true;
+    } else if (arg == "--ab" && i + 2 < argc) {
+      ab[0] = argv[++i];
+      ab[1] = argv[++i];
     } else if (arg == "--out" && i + 1 < argc) {
       out = argv[++i];
       out_given = true;
     } else if (arg == "--reps" && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
       if (reps < 1 || reps > 1000) fail("--reps wants 1..1000");
+      reps_given = true;
     } else if (arg == "--help" || arg == "-h") {
       usage(0);
     } else {
@@ -1434,6 +1624,7 @@ int main(int argc, char** argv) {
       usage(2);
     }
   }
+  if (!ab[0].empty()) return run_ab(ab[0], ab[1], reps_given ? reps : 31);
   const std::uint32_t default_isa = ampm_isa();
   std::vector<std::uint32_t> isas;
   for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}, std::uint32_t{AMPM_ISA_SCALAR}})
