@@ -121,16 +121,17 @@ where
     ) {
         // With the axis-0 node offsets o₀ of the lanes.
         let lanes = axis0::<T, R, D, K>(r.s, s0);
+        let impulse = self.args.impulse_dt != T::ZERO;
         for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
-            self.channel_coef(r, lanes, kind, c);
+            self.channel_coef(r, lanes, kind, impulse, c);
         }
     }
 
     /// [`Self::set_coef`] for the channel set mass, then momentum along every axis (the
-    /// usual collocated P2G), then with `heat` the three heat channels, known at compile time:
-    /// the lane vectors stay in registers.
+    /// usual collocated P2G), then with `heat` the three heat channels, known at compile time
+    /// (and whether `Δt_f ≠ 0`, `B`): the lane vectors stay in registers.
     #[inline(always)]
-    fn fixed_coef<R: Lane<Scalar = T>, const K: usize>(
+    fn fixed_coef<R: Lane<Scalar = T>, const K: usize, const B: bool>(
         &self,
         r: &Ready<'_, T, D>,
         s0: usize,
@@ -140,11 +141,11 @@ where
         let z = Coef::only(R::splat(T::ZERO));
         let (mut mm, mut hc) = ([z; 4], [z; 3]);
         for (kind, c) in mm.iter_mut().enumerate().take(D + 1) {
-            self.channel_coef(r, lanes, kind, c);
+            self.channel_coef(r, lanes, kind, B, c);
         }
         if heat {
             for (h, c) in hc.iter_mut().enumerate() {
-                self.channel_coef(r, lanes, 7 + h, c);
+                self.channel_coef(r, lanes, 7 + h, B, c);
             }
         }
         (mm, hc)
@@ -152,13 +153,14 @@ where
 
     /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
     /// force, `7..` heat) from the axis-0 lanes `(w, dw, o₀)` of [`axis0`], into `c` (fields
-    /// that the channel does not use are left as they are).
+    /// that the channel does not use are left as they are); `impulse`: `Δt_f ≠ 0`.
     #[inline(always)]
     fn channel_coef<R: Lane<Scalar = T>>(
         &self,
         r: &Ready<'_, T, D>,
         (w, dw, o0): (R, R, R),
         kind: usize,
+        impulse: bool,
         c: &mut Coef<R, D>,
     ) {
         let sp = R::splat;
@@ -169,7 +171,7 @@ where
                 // w (q₀ + (mCh) o) + Δt_f f.
                 let a = k - 1;
                 let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
-                if idt == T::ZERO {
+                if !impulse {
                     c.p = w * q;
                     c.has_b = false;
                 } else {
@@ -224,10 +226,11 @@ where
         } else {
             // A constant in each loop (`SET`), so the heat terms fold away or stay.
             let heat = SET == WITH_HEAT;
-            let c = self.fixed_coef::<R, K>(r, s[0], heat);
             if idt == T::ZERO {
+                let c = self.fixed_coef::<R, K, false>(r, s[0], heat);
                 tile.add_fixed::<K, false>(&s, r.s, &c, heat);
             } else {
+                let c = self.fixed_coef::<R, K, true>(r, s[0], heat);
                 tile.add_fixed::<K, true>(&s, r.s, &c, heat);
             }
         }
@@ -500,9 +503,14 @@ where
                 let (co, ck) = evaluate(V::load(&b.mu[..lanes]), &f);
                 tau = mul_nt(&ahat(&co), &f);
                 let bits = check_bits::<V>(&ck);
+                // The lanes flagged by any check (usually none: no lane is looked up).
+                let mut flagged = 0;
+                for (m, _) in &bits {
+                    flagged |= m;
+                }
                 for (l, e) in lane_err.iter_mut().enumerate().take(len) {
                     // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                    if b.mu[l] > T::ZERO {
+                    if flagged >> l & 1 == 1 && b.mu[l] > T::ZERO {
                         *e = lane_error(&bits, l);
                     }
                 }
