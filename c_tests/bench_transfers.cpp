@@ -56,8 +56,9 @@
 // prepare), the two builds alternating rep by rep (which goes first alternates too), so that
 // both see the same machine state; medians of R reps (default 31) and the ratio B / A. A
 // change of a few percent, below the spread between separate runs of the benchmark, shows
-// in the ratio. Both builds must return AMPM_OK and the same grids and particles, bit for bit
-// (a performance change must not change results; the check runs before timing).
+// in the ratio. Both builds must return AMPM_OK and the same results, bit for bit (P2G's node
+// channels; G2P's particle positions, velocities, C, F_E, F_P, temperatures, latent buffers and
+// phases; apply's forces), checked before timing: a performance change must not change them.
 //
 // --check (and every timing run, before timing): on tiny blocks (6³, 14²), every call returns
 // AMPM_OK with first_failed = n and finite results; for the elastic scene the library's and the
@@ -1501,28 +1502,27 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
   // Results first: the same grids, particles and forces from both builds, bit for bit.
   std::vector<T> grid[2], parts[2], df[2];
+  std::vector<std::uint8_t> phase[2];
+  auto append = [](std::vector<T>& to, const std::vector<T>& from) { to.insert(to.end(), from.begin(), from.end()); };
   for (int k = 0; k < 2; ++k) {
     cs.restore();
     cs.g.zero_p2g();
     p2g(k);
-    grid[k] = cs.g.mass;
-    for (int a = 0; a < D; ++a) grid[k].insert(grid[k].end(), cs.g.mom[a].begin(), cs.g.mom[a].end());
+    for (const auto* ch : {&cs.g.mass, &cs.g.hc, &cs.g.te, &cs.g.cond}) append(grid[k], *ch);
+    for (int a = 0; a < D; ++a) append(grid[k], cs.g.mom[a]);
     grid_update(cs.g, cs.thermal);
     g2p(k);
-    parts[k] = cs.p.x;
-    parts[k].insert(parts[k].end(), cs.p.v.begin(), cs.p.v.end());
-    parts[k].insert(parts[k].end(), cs.p.c.begin(), cs.p.c.end());
-    parts[k].insert(parts[k].end(), cs.p.fe.begin(), cs.p.fe.end());
-    parts[k].insert(parts[k].end(), cs.p.t.begin(), cs.p.t.end());
+    for (const auto* f : {&cs.p.x, &cs.p.v, &cs.p.c, &cs.p.fe, &cs.p.fp, &cs.p.t, &cs.p.u}) append(parts[k], *f);
+    phase[k] = cs.p.ph;
     cs.restore();
     prepare(k);
     apply(k);
-    for (int a = 0; a < D; ++a) df[k].insert(df[k].end(), cs.g.df[a].begin(), cs.g.df[a].end());
+    for (int a = 0; a < D; ++a) append(df[k], cs.g.df[a]);
   }
   auto same = [](const std::vector<T>& a, const std::vector<T>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
   };
-  if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(df[0], df[1]))
+  if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(df[0], df[1]) || phase[0] != phase[1])
     fail(cs.label("results") + " on " + isa_name(isa) + ": the two builds differ");
   std::vector<double> lib[2], app[2];
   for (int r = -1; r < reps; ++r) {
