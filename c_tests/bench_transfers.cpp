@@ -120,6 +120,11 @@ struct Api;
     static constexpr auto node_range = ampm_node_range_##D##d_##S;      \
     static constexpr auto prepare = ampm_force_prepare_##D##d_##S;      \
     static constexpr auto apply = ampm_force_apply_##D##d_##S;          \
+    /* The same symbols by name, for a build loaded with dlopen (--ab). */ \
+    static constexpr const char* p2g_sym = "ampm_p2g_" #D "d_" #S;      \
+    static constexpr const char* g2p_sym = "ampm_g2p_update_" #D "d_" #S; \
+    static constexpr const char* prepare_sym = "ampm_force_prepare_" #D "d_" #S; \
+    static constexpr const char* apply_sym = "ampm_force_apply_" #D "d_" #S; \
     static constexpr std::size_t slot_len =                             \
         D == 2 ? AMPM_FORCE_SLOT_LEN_2D : AMPM_FORCE_SLOT_LEN_3D;       \
     using Material = AmpmMaterial_##S;                                  \
@@ -724,28 +729,29 @@ struct Case {
     std::copy(p0.u.begin(), p0.u.end(), p.u.begin());
     std::copy(p0.ph.begin(), p0.ph.end(), p.ph.begin());
   }
-  AmpmStatus p2g_sym(std::size_t* ff) {
+  // Each call through `f`: this binary's symbol by default, another build's with --ab.
+  AmpmStatus p2g_sym(std::size_t* ff, decltype(A::p2g) f = A::p2g) {
     const auto m = material<T, D>(scene, false);
     auto pv = p.view();
-    return A::p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, p.n, &pv, &v.sym, ff);
+    return f(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, p.n, &pv, &v.sym, ff);
   }
   AmpmStatus p2g_f(std::size_t* ff) {
     const auto m = material<T, D>(scene, false);
     auto pv = p.view();
     return A::p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, T(0), p.n, &pv, &v.plus_f, ff);
   }
-  AmpmStatus g2p(std::size_t* ff) {
+  AmpmStatus g2p(std::size_t* ff, decltype(A::g2p) f = A::g2p) {
     const auto m = material<T, D>(scene, false);
     auto pv = p.view();
-    return A::g2p(&m, AMPM_KERNEL_QUADRATIC, h, dt, p.n, &pv, &v.g2p, ff);
+    return f(&m, AMPM_KERNEL_QUADRATIC, h, dt, p.n, &pv, &v.g2p, ff);
   }
-  AmpmStatus prepare(std::size_t* ff) {
+  AmpmStatus prepare(std::size_t* ff, decltype(A::prepare) f = A::prepare) {
     const auto m = material<T, D>(scene, true);
     auto pv = p.view();
-    return A::prepare(&m, p.n, &pv, slots.data(), ff);
+    return f(&m, p.n, &pv, slots.data(), ff);
   }
-  AmpmStatus apply(std::size_t* ff) {
-    return A::apply(AMPM_KERNEL_QUADRATIC, h, p.n, p.x.data(), slots.data(), &v.force, ff);
+  AmpmStatus apply(std::size_t* ff, decltype(A::apply) f = A::apply) {
+    return f(AMPM_KERNEL_QUADRATIC, h, p.n, p.x.data(), slots.data(), &v.force, ff);
   }
   void zero_df() {
     for (int a = 0; a < D; ++a) std::fill(g.df[a].begin(), g.df[a].end(), T(0));
@@ -1452,14 +1458,11 @@ struct AbFns {
   std::remove_const_t<decltype(A::prepare)> prepare;
   std::remove_const_t<decltype(A::apply)> apply;
 
-  explicit AbFns(const AbLib& l) {
-    const std::string s = std::string(std::is_same<T, float>::value ? "f32" : "f64");
-    const std::string d = std::to_string(D) + "d_";
-    p2g = l.sym<decltype(p2g)>("ampm_p2g_" + d + s);
-    g2p = l.sym<decltype(g2p)>("ampm_g2p_update_" + d + s);
-    prepare = l.sym<decltype(prepare)>("ampm_force_prepare_" + d + s);
-    apply = l.sym<decltype(apply)>("ampm_force_apply_" + d + s);
-  }
+  explicit AbFns(const AbLib& l)
+      : p2g(l.sym<decltype(p2g)>(A::p2g_sym)),
+        g2p(l.sym<decltype(g2p)>(A::g2p_sym)),
+        prepare(l.sym<decltype(prepare)>(A::prepare_sym)),
+        apply(l.sym<decltype(apply)>(A::apply_sym)) {}
 };
 
 /// One A/B row: medians (ns per particle) of both builds.
@@ -1477,26 +1480,15 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   const AbFns<T, D> fns[2] = {AbFns<T, D>(*libs[0]), AbFns<T, D>(*libs[1])};
   const std::size_t n = cs.p.n;
   std::size_t ff = 0;
-  const auto m = material<T, D>(s, false);
-  const auto mp = material<T, D>(s, true);
   auto check = [&](int k, const char* what, AmpmStatus st) {
     expect_ok(cs.label(what) + " (" + libs[k]->path + ")", st, ff, n);
   };
-  auto p2g = [&](int k) {
-    auto pv = cs.p.view();
-    check(k, "P2G sym", fns[k].p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, cs.h, cs.dt, n, &pv, &cs.v.sym, &ff));
-  };
-  auto g2p = [&](int k) {
-    auto pv = cs.p.view();
-    check(k, "G2P", fns[k].g2p(&m, AMPM_KERNEL_QUADRATIC, cs.h, cs.dt, n, &pv, &cs.v.g2p, &ff));
-  };
-  auto prepare = [&](int k) {
-    auto pv = cs.p.view();
-    check(k, "prepare", fns[k].prepare(&mp, n, &pv, cs.slots.data(), &ff));
-  };
+  auto p2g = [&](int k) { check(k, "P2G sym", cs.p2g_sym(&ff, fns[k].p2g)); };
+  auto g2p = [&](int k) { check(k, "G2P", cs.g2p(&ff, fns[k].g2p)); };
+  auto prepare = [&](int k) { check(k, "prepare", cs.prepare(&ff, fns[k].prepare)); };
   auto apply = [&](int k) {
     cs.zero_df();
-    check(k, "apply", fns[k].apply(AMPM_KERNEL_QUADRATIC, cs.h, n, cs.p.x.data(), cs.slots.data(), &cs.v.force, &ff));
+    check(k, "apply", cs.apply(&ff, fns[k].apply));
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
