@@ -52,13 +52,14 @@
 // --ab: two builds of the library (say, before and after a change) in one process, each
 // loaded from its own libampm.so with dlopen (its own copy of the library's state). For every
 // scene but snow, 3D and 2D f32, every instruction set both accept: lib (P2G sym + G2P, each
-// build its own P2G, grid update and G2P) and apply (zeroing df + apply, after an untimed
-// prepare), the two builds alternating rep by rep (which goes first alternates too), so that
-// both see the same machine state; medians of R reps (default 31) and the ratio B / A. A
-// change of a few percent, below the spread between separate runs of the benchmark, shows
-// in the ratio. Both builds must return AMPM_OK and the same results, bit for bit (P2G's node
-// channels; G2P's particle positions, velocities, C, F_E, F_P, temperatures, latent buffers and
-// phases; apply's forces), checked before timing: a performance change must not change them.
+// build its own P2G, grid update and G2P), prepare and apply (zeroing df + apply), the two
+// builds alternating rep by rep (which goes first alternates too), so that both see the same
+// machine state; medians of R reps (default 31) and the ratio B / A. A change of a few
+// percent, below the spread between separate runs of the benchmark, shows in the ratio. Both
+// builds must return AMPM_OK and the same results, bit for bit (P2G's node channels; G2P's
+// particle positions, velocities, C, F_E, F_P, temperatures, latent buffers and phases;
+// prepare's slots; apply's forces), checked before timing: a performance change must not
+// change them.
 //
 // --check (and every timing run, before timing): on tiny blocks (6³, 14²), every call returns
 // AMPM_OK with first_failed = n and finite results; for the elastic scene the library's and the
@@ -1468,7 +1469,7 @@ struct AbFns {
 /// One A/B row: medians (ns per particle) of both builds.
 struct AbRow {
   std::string scene, kase, isa;
-  double lib[2] = {NAN, NAN}, apply[2] = {NAN, NAN};
+  double lib[2] = {NAN, NAN}, prepare[2] = {NAN, NAN}, apply[2] = {NAN, NAN};
 };
 
 /// Times one case on instruction set `isa` with both builds alternately (see the header).
@@ -1493,7 +1494,7 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
   // Results first: the same grids, particles and forces from both builds, bit for bit.
-  std::vector<T> grid[2], parts[2], df[2];
+  std::vector<T> grid[2], parts[2], slots[2], df[2];
   std::vector<std::uint8_t> phase[2];
   auto append = [](std::vector<T>& to, const std::vector<T>& from) { to.insert(to.end(), from.begin(), from.end()); };
   for (int k = 0; k < 2; ++k) {
@@ -1508,15 +1509,17 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
     phase[k] = cs.p.ph;
     cs.restore();
     prepare(k);
+    slots[k] = cs.slots;
     apply(k);
     for (int a = 0; a < D; ++a) append(df[k], cs.g.df[a]);
   }
   auto same = [](const std::vector<T>& a, const std::vector<T>& b) {
     return a.size() == b.size() && std::memcmp(a.data(), b.data(), a.size() * sizeof(T)) == 0;
   };
-  if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(df[0], df[1]) || phase[0] != phase[1])
+  if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(slots[0], slots[1]) || !same(df[0], df[1]) ||
+      phase[0] != phase[1])
     fail(cs.label("results") + " on " + isa_name(isa) + ": the two builds differ");
-  std::vector<double> lib[2], app[2];
+  std::vector<double> lib[2], prep[2], app[2];
   for (int r = -1; r < reps; ++r) {
     for (int j = 0; j < 2; ++j) {
       const int k = (r + j + 2) % 2;
@@ -1530,11 +1533,16 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
       g2p(k);
       const auto t3 = clock();
       cs.restore();
-      prepare(k);
       const auto t4 = clock();
-      apply(k);
+      prepare(k);
       const auto t5 = clock();
-      if (r >= 0) lib[k].push_back(ns(t0, t1) + ns(t2, t3)), app[k].push_back(ns(t4, t5));
+      apply(k);
+      const auto t6 = clock();
+      if (r >= 0) {
+        lib[k].push_back(ns(t0, t1) + ns(t2, t3));
+        prep[k].push_back(ns(t4, t5));
+        app[k].push_back(ns(t5, t6));
+      }
     }
   }
   cs.restore();
@@ -1544,10 +1552,12 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   };
   AbRow row;
   row.scene = scene_name(s), row.kase = Api<T, D>::name, row.isa = isa_name(isa);
-  for (int k = 0; k < 2; ++k) row.lib[k] = median(lib[k]), row.apply[k] = median(app[k]);
-  std::fprintf(stderr, "%-14s %s %-8s lib %6.1f / %6.1f (%.3f)  apply %6.1f / %6.1f (%.3f)\n", row.scene.c_str(),
-               row.kase.c_str(), row.isa.c_str(), row.lib[0], row.lib[1], row.lib[1] / row.lib[0], row.apply[0],
-               row.apply[1], row.apply[1] / row.apply[0]);
+  for (int k = 0; k < 2; ++k)
+    row.lib[k] = median(lib[k]), row.prepare[k] = median(prep[k]), row.apply[k] = median(app[k]);
+  std::fprintf(stderr, "%-14s %s %-8s lib %6.1f / %6.1f (%.3f)  prepare %6.1f / %6.1f (%.3f)  apply %6.1f / %6.1f (%.3f)\n",
+               row.scene.c_str(), row.kase.c_str(), row.isa.c_str(), row.lib[0], row.lib[1], row.lib[1] / row.lib[0],
+               row.prepare[0], row.prepare[1], row.prepare[1] / row.prepare[0], row.apply[0], row.apply[1],
+               row.apply[1] / row.apply[0]);
   rows.push_back(row);
 }
 
@@ -1564,7 +1574,8 @@ int run_ab(const std::string& a, const std::string& b, int reps) {
   std::ostringstream o;
   o << "A/B (bench_transfers --ab, " << reps << " reps, alternating): A = `" << a << "`, B = `" << b << "`\n"
     << "CPU: " << cpu_model() << "; load before: " << load_average() << "\n\n"
-    << "| scene | case | ISA | lib A | lib B | B / A | apply A | apply B | B / A |\n|---|---|---|---|---|---|---|---|---|\n";
+    << "| scene | case | ISA | lib A | lib B | B / A | prepare A | prepare B | B / A | apply A | apply B | B / A |\n"
+    << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   char buf[64];
   auto num = [&](double x, const char* f) {
     std::snprintf(buf, sizeof buf, f, x);
@@ -1572,7 +1583,9 @@ int run_ab(const std::string& a, const std::string& b, int reps) {
   };
   for (const AbRow& r : rows)
     o << "| " << r.scene << " | " << r.kase << " | " << r.isa << " | " << num(r.lib[0], "%.1f") << " | "
-      << num(r.lib[1], "%.1f") << " | " << num(r.lib[1] / r.lib[0], "%.3f") << " | " << num(r.apply[0], "%.1f")
+      << num(r.lib[1], "%.1f") << " | " << num(r.lib[1] / r.lib[0], "%.3f") << " | " << num(r.prepare[0], "%.1f")
+      << " | " << num(r.prepare[1], "%.1f") << " | " << num(r.prepare[1] / r.prepare[0], "%.3f") << " | "
+      << num(r.apply[0], "%.1f")
       << " | " << num(r.apply[1], "%.1f") << " | " << num(r.apply[1] / r.apply[0], "%.3f") << " |\n";
   std::fputs(o.str().c_str(), stdout);
   return 0;

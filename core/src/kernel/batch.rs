@@ -21,7 +21,7 @@
 
 use super::chunk::{check_bits, gather, load_mats, none, scatter, store_mats, First};
 use super::prepared::{self, MAX_LEN};
-use super::{ahat, chat_z, evaluate, psd_block, Dim, LaneDim};
+use super::{ahat, chat_z, evaluate, flagged, psd_block, Dim, LaneDim};
 use crate::error::Error;
 use crate::lane::lmat::all_finite;
 use crate::lane::{Isa, IsaKind, Lane, Pair, X2};
@@ -302,7 +302,7 @@ where
                     (V::mask_bits(bad_z), Error::NonFinite),
                     (V::mask_bits(ovf), Error::Overflow),
                 ];
-                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
+                let skip = flagged(&bits);
                 if let Some(m) = a_m {
                     store_mats::<V, D>(&m, a.ahat.add(start * e), len, skip);
                 }
@@ -438,7 +438,7 @@ where
                 };
                 let [b0, b1, b2, b3, b4] = check_bits::<V>(&ck);
                 let bits = [b0, b1, b2, b3, b4, (V::mask_bits(ovf), Error::Overflow)];
-                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
+                let skip = flagged(&bits);
                 if let Some(m) = a_m {
                     store_mats::<V, D>(&m, a.ahat.add(start * e), len, skip);
                 }
@@ -508,7 +508,7 @@ where
                     (V::mask_bits(!all_finite(&z)), Error::NonFinite),
                     (V::mask_bits(!all_finite(&m)), Error::Overflow),
                 ];
-                let skip = bits.iter().fold(0u64, |x, (b, _)| x | b);
+                let skip = flagged(&bits);
                 store_mats::<V, D>(&m, a.out.add(start * e), len, skip);
                 first.note(start, &bits, len);
             }

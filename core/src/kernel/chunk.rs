@@ -2,7 +2,7 @@
 //! the bookkeeping of statuses: what every chunk loop of [`super::batch`] shares.
 
 use super::batch::MAX_LANES;
-use super::{lane_error, Checks};
+use super::{flagged, lane_error, Checks};
 use crate::error::Error;
 use crate::lane::lmat::LMat;
 use crate::lane::Lane;
@@ -142,8 +142,7 @@ pub(crate) unsafe fn store_mats<V: Lane, const D: usize>(
 /// The first failure of a chunk, if any, as `(lane, status)`.
 #[inline(always)]
 pub(crate) fn first_error(bits: &[(u64, Error)], len: usize) -> Option<(usize, Error)> {
-    let all = bits.iter().fold(0u64, |a, (b, _)| a | b);
-    let all = all & (u64::MAX >> (64 - len as u32));
+    let all = flagged(bits) & (u64::MAX >> (64 - len as u32));
     if all == 0 {
         return None;
     }

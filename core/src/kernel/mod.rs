@@ -156,6 +156,14 @@ pub fn lane_error(bits: &[(u64, Error)], l: usize) -> Option<Error> {
     bits.iter().find(|(b, _)| b >> l & 1 == 1).map(|&(_, e)| e)
 }
 
+/// The lanes that any check of `bits` flags (bit `l` for lane `l`): [`lane_error`] is `None`
+/// for every other lane, so a caller looks up only these (usually none).
+#[inline(always)]
+#[must_use]
+pub fn flagged(bits: &[(u64, Error)]) -> u64 {
+    bits.iter().fold(0u64, |a, (b, _)| a | b)
+}
+
 /// `if m { a } else { b }` entry-wise.
 #[inline(always)]
 #[must_use]

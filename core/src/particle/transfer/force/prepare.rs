@@ -3,7 +3,7 @@
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, WIDE_LANES};
 use crate::kernel::chunk::check_bits;
-use crate::kernel::{evaluate, lane_error, Dim, LaneDim};
+use crate::kernel::{evaluate, flagged, lane_error, Dim, LaneDim};
 use crate::lane::lmat::LMat;
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
@@ -155,6 +155,7 @@ where
             let (co, ck) = evaluate(mu, &f);
             let b = blocks(&co, alpha, beta, nv, psd);
             let bits = check_bits::<V>(&ck);
+            let flagged = flagged(&bits);
             let mut ent = [V::splat(T::ZERO); slot_len(3)];
             entries(&b, &mut ent);
             let mut out = [[T::ZERO; WIDE_LANES]; slot_len(3)];
@@ -172,7 +173,8 @@ where
             for l in 0..len {
                 let i = start + l;
                 let mut e = err[l];
-                if e.is_none() && sbuf[0][l] > T::ZERO {
+                // Lanes with μ = 0 ran no decomposition in the scalar path either.
+                if e.is_none() && flagged >> l & 1 == 1 && sbuf[0][l] > T::ZERO {
                     e = lane_error(&bits, l);
                 }
                 if e.is_none() && !ok_bits[l].is_finite() {

@@ -8,7 +8,7 @@ use super::{P2gOp, Pre, Ready, Run};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithChunks};
 use crate::kernel::chunk::check_bits;
-use crate::kernel::{ahat, evaluate, lane_error, Dim, LaneDim};
+use crate::kernel::{ahat, evaluate, flagged, lane_error, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
 use crate::lane::{Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
@@ -503,11 +503,7 @@ where
                 let (co, ck) = evaluate(V::load(&b.mu[..lanes]), &f);
                 tau = mul_nt(&ahat(&co), &f);
                 let bits = check_bits::<V>(&ck);
-                // The lanes flagged by any check (usually none: no lane is looked up).
-                let mut flagged = 0;
-                for (m, _) in &bits {
-                    flagged |= m;
-                }
+                let flagged = flagged(&bits);
                 for (l, e) in lane_err.iter_mut().enumerate().take(len) {
                     // Lanes with μ = 0 ran no decomposition in the scalar path either.
                     if flagged >> l & 1 == 1 && b.mu[l] > T::ZERO {
