@@ -1,12 +1,12 @@
-//! The kernels: the actions of 𝓑(F), and Ψ̂, Â, Ĉ:Z single and batch.
+//! The kernels at one point: the actions of 𝓑(F), and Ψ̂, Â, Ĉ:Z.
 
 use super::{Module, Op};
 
 pub const MODULE: Module = Module {
     name: "kernels",
-    doc: "The C entry points of the kernels: the actions of 𝓑(F), and Ψ̂, Â, Ĉ:Z single and
-        batch. The 𝓑 bodies are in `crate::kernels_impl`; the energy kernels run on
-        `ampm_core::kernel` through `crate::fast`.",
+    doc: "The C entry points of the kernels at one point: the actions of 𝓑(F), and Ψ̂, Â, Ĉ:Z
+        (their batch forms are in `kernels_batch`). The 𝓑 bodies are in `crate::kernels_impl`;
+        the energy kernels run on `ampm_core::kernel` through `crate::fast`.",
     uses: &[
         "crate::fast",
         "crate::kernels_impl",
@@ -97,70 +97,6 @@ pub const MODULE: Module = Module {
                     out,
                     ptr::null_mut(),
                     false,
-                )",
-        },
-        Op {
-            name: "ahat_batch",
-            doc: "
-                Computes Â for n particles: out[i] = Â(mu[i], F[i]) (see ampm_ahat_{sfx}).
-
-                `n`: number of particles; `mu`: n values (Pa, ≥ 0); `f`, `out`: n {DxD}
-                column-major matrices back to back ({DD} scalars each; `out` may be `f`).
-
-                {BATCH}",
-            params: &[
-                "n: usize",
-                "mu: *const {T}",
-                "f: *const {T}",
-                "out: *mut {T}",
-                "first_failed: *mut usize",
-            ],
-            ret: "AmpmStatus",
-            body: "
-                fast::kernels::<{T}, {D}>(
-                    fast::isa(),
-                    n,
-                    mu,
-                    f,
-                    ptr::null(),
-                    out,
-                    ptr::null_mut(),
-                    ptr::null_mut(),
-                    false,
-                    first_failed,
-                )",
-        },
-        Op {
-            name: "chat_z_batch",
-            doc: "
-                Computes Ĉ:Z for n particles: out[i] = Ĉ(mu[i], F[i]):Z[i] (see
-                ampm_chat_z_{sfx}).
-
-                `n`: number of particles; `mu`: n values (Pa, ≥ 0); `f`, `z`, `out`: n {DxD}
-                column-major matrices back to back ({DD} scalars each; `out` may be `f` or `z`).
-
-                {BATCH}",
-            params: &[
-                "n: usize",
-                "mu: *const {T}",
-                "f: *const {T}",
-                "z: *const {T}",
-                "out: *mut {T}",
-                "first_failed: *mut usize",
-            ],
-            ret: "AmpmStatus",
-            body: "
-                fast::kernels::<{T}, {D}>(
-                    fast::isa(),
-                    n,
-                    mu,
-                    f,
-                    z,
-                    ptr::null_mut(),
-                    out,
-                    ptr::null_mut(),
-                    false,
-                    first_failed,
                 )",
         },
     ],

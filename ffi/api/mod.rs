@@ -39,8 +39,11 @@
 //! mentions a Rust source file, and on a symbol defined twice. `doc` and `body` may span lines;
 //! their common indentation is removed.
 
+mod fields;
+mod force;
 mod hessian;
 mod kernels;
+mod kernels_batch;
 mod methods;
 mod particle;
 mod prepared;
@@ -75,10 +78,13 @@ pub struct Module {
 /// Every module, in the order of the header.
 pub const MODULES: &[Module] = &[
     kernels::MODULE,
+    kernels_batch::MODULE,
     prepared::MODULE,
     hessian::MODULE,
     methods::MODULE,
     particle::MODULE,
+    force::MODULE,
+    fields::MODULE,
 ];
 
 /// Placeholders whose value depends on the dimension: `(name, in 2D, in 3D)`.

@@ -7,6 +7,9 @@
 pub mod kernels;
 
 #[rustfmt::skip]
+pub mod kernels_batch;
+
+#[rustfmt::skip]
 pub mod prepared;
 
 #[rustfmt::skip]
@@ -17,3 +20,9 @@ pub mod methods;
 
 #[rustfmt::skip]
 pub mod particle;
+
+#[rustfmt::skip]
+pub mod force;
+
+#[rustfmt::skip]
+pub mod fields;

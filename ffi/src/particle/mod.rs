@@ -7,6 +7,8 @@
 
 pub(crate) mod imp;
 
+pub use crate::generated::fields::*;
+pub use crate::generated::force::*;
 pub use crate::generated::particle::*;
 
 use core::ffi::{c_int, c_uchar, c_uint};
