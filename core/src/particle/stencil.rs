@@ -275,8 +275,8 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         // The positions per axis: on `f32` chunks wider than eight lanes, the records
         // transposed in registers ([`Lane::load_records`]), since the copy's scalar stores
         // cannot forward to the wide load that follows them; otherwise copied through `xa`
-        // (faster on eight lanes; `f64` record loads are gathers). Measurements: README,
-        // "MPM particle updates", the paragraph on what still limits the transfers.
+        // (faster on eight lanes; `f64` record loads are gathers). Measurements:
+        // `docs/transfer-performance.md`, "What limits the targets".
         let mut xv = [zero; D];
         let records = size_of::<T>() == 4 && n > 8;
         if records {
