@@ -24,6 +24,7 @@
 
 pub mod batch;
 pub(crate) mod chunk;
+mod dispatch;
 pub mod prepared;
 
 use crate::error::Error;
