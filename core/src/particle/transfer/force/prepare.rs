@@ -155,7 +155,7 @@ where
             let (co, ck) = evaluate(mu, &f);
             let b = blocks(&co, alpha, beta, nv, psd);
             let bits = check_bits::<V>(&ck);
-            let flagged = flagged(&bits);
+            let flagged_lanes = flagged(&bits);
             let mut ent = [V::splat(T::ZERO); slot_len(3)];
             entries(&b, &mut ent);
             let mut out = [[T::ZERO; WIDE_LANES]; slot_len(3)];
@@ -174,7 +174,7 @@ where
                 let i = start + l;
                 let mut e = err[l];
                 // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                if e.is_none() && flagged >> l & 1 == 1 && sbuf[0][l] > T::ZERO {
+                if e.is_none() && flagged_lanes >> l & 1 == 1 && sbuf[0][l] > T::ZERO {
                     e = lane_error(&bits, l);
                 }
                 if e.is_none() && !ok_bits[l].is_finite() {

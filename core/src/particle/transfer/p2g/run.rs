@@ -503,10 +503,10 @@ where
                 let (co, ck) = evaluate(V::load(&b.mu[..lanes]), &f);
                 tau = mul_nt(&ahat(&co), &f);
                 let bits = check_bits::<V>(&ck);
-                let flagged = flagged(&bits);
+                let flagged_lanes = flagged(&bits);
                 for (l, e) in lane_err.iter_mut().enumerate().take(len) {
                     // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                    if flagged >> l & 1 == 1 && b.mu[l] > T::ZERO {
+                    if flagged_lanes >> l & 1 == 1 && b.mu[l] > T::ZERO {
                         *e = lane_error(&bits, l);
                     }
                 }
