@@ -202,3 +202,21 @@ pub(crate) fn check_bits<V: Lane>(ck: &Checks<V::Mask>) -> [(u64, Error); 5] {
         (V::mask_bits(ck.singular), Error::NonPositiveJ),
     ]
 }
+
+/// The status of lane `l` from the kernel's [`check_bits`], whose [`flagged`] lanes are
+/// `flagged_lanes`, for a particle with shear modulus `mu`: looked up only for a flagged lane
+/// (usually none), and `None` where `μ = 0` (a liquid's lane runs no decomposition in the
+/// scalar path either, so its checks of `F` do not apply).
+#[inline(always)]
+pub(crate) fn kernel_lane_error<T: Real>(
+    bits: &[(u64, Error)],
+    flagged_lanes: u64,
+    l: usize,
+    mu: T,
+) -> Option<Error> {
+    if flagged_lanes >> l & 1 == 1 && mu > T::ZERO {
+        lane_error(bits, l)
+    } else {
+        None
+    }
+}

@@ -2,8 +2,8 @@
 
 use crate::error::{Error, Result};
 use crate::kernel::batch::{dispatch, BatchReal, LaneOp, WIDE_LANES};
-use crate::kernel::chunk::check_bits;
-use crate::kernel::{evaluate, flagged, lane_error, Dim, LaneDim};
+use crate::kernel::chunk::{check_bits, kernel_lane_error};
+use crate::kernel::{evaluate, flagged, Dim, LaneDim};
 use crate::lane::lmat::LMat;
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
@@ -173,9 +173,8 @@ where
             for l in 0..len {
                 let i = start + l;
                 let mut e = err[l];
-                // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                if e.is_none() && flagged_lanes >> l & 1 == 1 && sbuf[0][l] > T::ZERO {
-                    e = lane_error(&bits, l);
+                if e.is_none() {
+                    e = kernel_lane_error(&bits, flagged_lanes, l, sbuf[0][l]);
                 }
                 if e.is_none() && !ok_bits[l].is_finite() {
                     e = Some(Error::Overflow);

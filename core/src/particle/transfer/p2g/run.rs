@@ -7,8 +7,8 @@ use super::lanes::{fm_lanes, ChunkBufs};
 use super::{P2gOp, Pre, Ready, Run};
 use crate::error::{Error, Result};
 use crate::kernel::batch::{BatchReal, LaneOp, ScalarRow, WithChunks};
-use crate::kernel::chunk::check_bits;
-use crate::kernel::{ahat, evaluate, flagged, lane_error, Dim, LaneDim};
+use crate::kernel::chunk::{check_bits, kernel_lane_error};
+use crate::kernel::{ahat, evaluate, flagged, Dim, LaneDim};
 use crate::lane::lmat::{mul_nt, LMat};
 use crate::lane::{Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
@@ -505,10 +505,7 @@ where
                 let bits = check_bits::<V>(&ck);
                 let flagged_lanes = flagged(&bits);
                 for (l, e) in lane_err.iter_mut().enumerate().take(len) {
-                    // Lanes with μ = 0 ran no decomposition in the scalar path either.
-                    if flagged_lanes >> l & 1 == 1 && b.mu[l] > T::ZERO {
-                        *e = lane_error(&bits, l);
-                    }
+                    *e = kernel_lane_error(&bits, flagged_lanes, l, b.mu[l]);
                 }
             }
             for j in 0..D {
