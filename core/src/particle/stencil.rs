@@ -181,6 +181,63 @@ pub struct Stencil<T, const D: usize> {
 /// comfortably in `i32`) are refused.
 const MAX_CELLS: f64 = 1_073_741_824.0; // 2^30
 
+/// The stencils of a chunk on SIMD lanes, stencil `l` in lane `l`: per axis `fx`, the weights
+/// `w[a][o]` and the derivatives `dw[a][o]` (1/m) of [`Stencil`] (`o < K`; the other entries
+/// 0), as [`Stencil::new_lanes`] computes them, the values it writes into the stencils (so
+/// that a caller that sums on lanes does not read them back from the stencils).
+pub(crate) struct StencilLanes<V> {
+    pub fx: [V; 3],
+    pub w: [[V; MAX_WIDTH]; 3],
+    pub dw: [[V; MAX_WIDTH]; 3],
+    /// Whether `new_lanes` also writes the weights and derivatives into the stencils (`true`
+    /// from [`StencilLanes::new`]); if not, the stencils' `w` and `dw` are left as they are,
+    /// for a caller that reads them only from the lanes.
+    pub records: bool,
+}
+
+impl<T: Real, V: Lane<Scalar = T>> StencilLanes<V> {
+    /// Every entry 0; the stencils' weights written too.
+    #[inline(always)]
+    pub fn new() -> Self {
+        let z = V::splat(T::ZERO);
+        Self {
+            fx: [z; 3],
+            w: [[z; MAX_WIDTH]; 3],
+            dw: [[z; MAX_WIDTH]; 3],
+            records: true,
+        }
+    }
+
+    /// `fx`, the weights and derivatives of `stencils[0..V::LANES]` (`K` nodes per axis),
+    /// stencil `l` in lane `l`, read from the stencils.
+    #[cfg(test)]
+    pub fn of<const D: usize, const K: usize>(stencils: &[Stencil<T, D>]) -> Self {
+        debug_assert!(stencils.len() >= V::LANES && K <= MAX_WIDTH);
+        let mut s = Self::new();
+        // Scalars per stencil: `Stencil` holds only `T`, `i32` and a one-byte enum (see
+        // `Stencil::new_lanes`).
+        let rec = size_of::<Stencil<T, D>>() / size_of::<T>();
+        let first = stencils.as_ptr();
+        // SAFETY: `stencils` holds `V::LANES` records of `rec` scalars; a field of record 0
+        // starts `rec·l` scalars before the same field of record `l`; `fx` has `D` scalars,
+        // `w[a]` and `dw[a]` have `MAX_WIDTH`.
+        unsafe {
+            V::load_records(
+                core::ptr::addr_of!((*first).fx).cast::<T>(),
+                rec,
+                &mut s.fx[..D],
+            );
+            for a in 0..D {
+                let pw = core::ptr::addr_of!((*first).w[a]).cast::<T>();
+                let pd = core::ptr::addr_of!((*first).dw[a]).cast::<T>();
+                V::load_records(pw, rec, &mut s.w[a][..K]);
+                V::load_records(pd, rec, &mut s.dw[a][..K]);
+            }
+        }
+        s
+    }
+}
+
 impl<T: Real, const D: usize> Stencil<T, D> {
     /// The stencil of a particle at `x` (m, relative to the grid origin) on grid `grid` with
     /// spacing `h` (m).
@@ -194,7 +251,7 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         // The checks give the statuses; the formulas are those of `new_lanes` on one lane.
         Self::check_position(grid, h, x)?;
         let mut s = [Self::blank(kernel, h)];
-        if Self::new_lanes::<T>(kernel, grid, h, core::slice::from_ref(x), &mut s) & 1 == 0 {
+        if Self::new_lanes::<T>(kernel, grid, h, core::slice::from_ref(x), &mut s, None) & 1 == 0 {
             // Not reached: `check_position` accepts exactly the lanes `new_lanes` does.
             return Err(Error::InvalidArgument);
         }
@@ -231,7 +288,10 @@ impl<T: Real, const D: usize> Stencil<T, D> {
     /// `out[l]`; [`Stencil::new`] is this on one lane. Returns the lanes done (bit `l` for
     /// lane `l`): there `out[l]` is `Stencil::new(kernel, grid, h, &xs[l])`. A lane is not
     /// done when its `Stencil::new` would fail (or `h` or `grid` is invalid: no lane is done);
-    /// the caller calls `Stencil::new` there and gets its error.
+    /// the caller calls `Stencil::new` there and gets its error. With `lanes`, the lane vectors
+    /// of `fx`, the weights and the derivatives are written there too (lane `l` of a done lane
+    /// is `out[l]`'s), and without [`StencilLanes::records`] the weights and derivatives of
+    /// `out` are left as they are.
     ///
     /// Per axis: `ξ = x/h − shift`; `⌊ξ⌋` (exact: `|ξ| < 2³⁰` is checked, and a value of `T`
     /// that large is an integer); `frac = ξ − ⌊ξ⌋`, exact (Sterbenz for `|ξ| ≥ 1`, trivially
@@ -246,6 +306,7 @@ impl<T: Real, const D: usize> Stencil<T, D> {
         h: T,
         xs: &[[T; D]],
         out: &mut [Self],
+        mut lanes: Option<&mut StencilLanes<V>>,
     ) -> u64 {
         // The widest chunk of any caller (P2G's `f32` chunks on AVX-512).
         const MAX: usize = crate::kernel::batch::WIDE_LANES;
@@ -330,12 +391,17 @@ impl<T: Real, const D: usize> Stencil<T, D> {
             for d in dw.iter_mut().take(k) {
                 *d *= V::splat(inv_h);
             }
-            // SAFETY: `out` holds `n = LANES` stencils; record `l` of `rec` scalars from the
-            // field of `out[0]` is the same field of `out[l]`, and `w[a]`, `dw[a]` are
-            // `MAX_WIDTH` scalars.
-            unsafe {
-                V::store_records(addr_of_mut!((*first).w[a]).cast::<T>(), rec, &w);
-                V::store_records(addr_of_mut!((*first).dw[a]).cast::<T>(), rec, &dw);
+            if let Some(sl) = lanes.as_deref_mut() {
+                (sl.fx[a], sl.w[a], sl.dw[a]) = (fx, w, dw);
+            }
+            if lanes.as_ref().is_none_or(|sl| sl.records) {
+                // SAFETY: `out` holds `n = LANES` stencils; record `l` of `rec` scalars from
+                // the field of `out[0]` is the same field of `out[l]`, and `w[a]`, `dw[a]` are
+                // `MAX_WIDTH` scalars.
+                unsafe {
+                    V::store_records(addr_of_mut!((*first).w[a]).cast::<T>(), rec, &w);
+                    V::store_records(addr_of_mut!((*first).dw[a]).cast::<T>(), rec, &dw);
+                }
             }
         }
         // SAFETY: as above; `fx` is `D` scalars.

@@ -2,7 +2,7 @@
 //! (which `tests/particle.rs` checks against an independent f64 B-spline), bit for
 //! bit, on every lane type the CPU has.
 
-use super::{quadratic_axis, Grid, Kernel, Stencil, MAX_CELLS, MAX_WIDTH};
+use super::{quadratic_axis, Grid, Kernel, Stencil, StencilLanes, MAX_CELLS, MAX_WIDTH};
 use crate::kernel::batch::{dispatch, BatchReal, BatchStatus, LaneOp, WIDE_LANES};
 use crate::lane::{Isa, Lane};
 use crate::scalar::Real;
@@ -23,7 +23,8 @@ fn bits<T: Real, const D: usize>(s: &Stencil<T, D>) -> Vec<u64> {
 }
 
 /// Runs `new_lanes` on the kernel lanes `V`, their wide form `V::Wide` and the row lanes `R` of
-/// an instruction set and compares every lane with `Stencil::new`.
+/// an instruction set and compares every lane with `Stencil::new`, both the stencils written and
+/// their lane vectors ([`StencilLanes`]).
 struct Check<'a, T, const D: usize> {
     kernel: Kernel,
     grid: Grid,
@@ -40,12 +41,36 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
             let mut xs = [[T::ZERO; D]; WIDE_LANES];
             xs[..chunk.len()].copy_from_slice(chunk);
             // Placeholders with values that a lane must overwrite.
-            let mut out = [Stencil::blank(Kernel::Cubic, T::from_i32(7)); WIDE_LANES];
-            for s in out.iter_mut() {
-                s.w = [[T::from_i32(9); 4]; D];
-                s.base = [-5; D];
-            }
-            let done = Stencil::new_lanes::<V>(self.kernel, self.grid, self.h, &xs[..n], &mut out);
+            let mut blank = Stencil::blank(Kernel::Cubic, T::from_i32(7));
+            blank.w = [[T::from_i32(9); 4]; D];
+            blank.base = [-5; D];
+            let mut out = [blank; WIDE_LANES];
+            let mut sl = StencilLanes::<V>::new();
+            let (k, h) = (self.kernel, self.h);
+            let done = Stencil::new_lanes::<V>(k, self.grid, h, &xs[..n], &mut out, Some(&mut sl));
+            // Without `records`: the same lanes, the stencils' weights left as they were.
+            let mut out2 = [blank; WIDE_LANES];
+            let mut sl2 = StencilLanes::<V>::new();
+            sl2.records = false;
+            let done2 =
+                Stencil::new_lanes::<V>(k, self.grid, h, &xs[..n], &mut out2, Some(&mut sl2));
+            assert_eq!(done2, done);
+            // Lane `l` of the lane vectors `s`, with the rest of `out[l]`.
+            let lane = |s: &StencilLanes<V>, l: usize| {
+                let at = |v: V| {
+                    let mut a = [T::ZERO; WIDE_LANES];
+                    v.store(&mut a[..n]);
+                    a[l]
+                };
+                let mut r = out[l];
+                for a in 0..D {
+                    r.fx[a] = at(s.fx[a]);
+                    for o in 0..4 {
+                        (r.w[a][o], r.dw[a][o]) = (at(s.w[a][o]), at(s.dw[a][o]));
+                    }
+                }
+                r
+            };
             for (l, x) in xs.iter().enumerate().take(n) {
                 let want = Stencil::new(self.kernel, self.grid, self.h, x);
                 let on = done >> l & 1 == 1;
@@ -56,6 +81,18 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
                 );
                 if let Ok(w) = want {
                     assert_eq!(bits(&out[l]), bits(&w), "lane {l} of {n} at {x:?}");
+                    assert_eq!(bits(&lane(&sl, l)), bits(&w), "lane vectors {l} of {n}");
+                    assert_eq!(bits(&lane(&sl2, l)), bits(&w), "no records: {l} of {n}");
+                    let kept = Stencil {
+                        w: blank.w,
+                        dw: blank.dw,
+                        ..w
+                    };
+                    assert_eq!(
+                        bits(&out2[l]),
+                        bits(&kept),
+                        "no records: {l} of {n} at {x:?}"
+                    );
                     self.done += 1;
                 }
             }
@@ -180,10 +217,11 @@ fn invalid_spacing_or_face_does_no_lane() {
     let xs = [[0.25f32; 3]; 8];
     let mut out = [Stencil::blank(Kernel::Quadratic, 1.0); 8];
     for h in [0.0, -1.0, f32::NAN, f32::INFINITY, 1e-45] {
-        let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Collocated, h, &xs, &mut out);
+        let d =
+            Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Collocated, h, &xs, &mut out, None);
         assert_eq!(d, 0, "h = {h}");
     }
-    let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Face(3), 1.0, &xs, &mut out);
+    let d = Stencil::new_lanes::<f32>(Kernel::Quadratic, Grid::Face(3), 1.0, &xs, &mut out, None);
     assert_eq!(d, 0);
 }
 

@@ -21,7 +21,7 @@ use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow};
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::apic::inv_kappa_h;
-use crate::particle::stencil::{Grid, Kernel, Stencil};
+use crate::particle::stencil::{Grid, Kernel, Stencil, StencilLanes};
 use crate::particle::update::{update_validated, G2pSample};
 use crate::particle::Material;
 use crate::polar::{DefaultSvd, SvdMethod};
@@ -175,6 +175,12 @@ where
         let (kernel, h) = (self.args.kernel, self.args.h);
         let mut xs = [[T::ZERO; D]; CHUNK];
         let mut stencils = [Stencil::blank(kernel, h); CHUNK];
+        // The same stencils on lanes: where a lane's stencil is not done, its particle does
+        // not sample (its `Stencil::new` fails), so the lanes of every particle that samples
+        // hold its stencil. The velocity sums read the weights from the lanes; only the
+        // temperatures' sums and the MAC grid's read them from the stencils.
+        let mut lane_stencils = StencilLanes::<R>::new();
+        lane_stencils.records = self.faces.is_some() || self.material.heat.is_some();
         let mut start = 0;
         while start < self.n {
             let len = CHUNK.min(self.n - start);
@@ -187,6 +193,7 @@ where
                     (start, len),
                     &mut xs,
                     &mut stencils,
+                    Some(&mut lane_stencils),
                 )
             };
             let whole = len == CHUNK;
@@ -197,6 +204,7 @@ where
                 } else {
                     Stencil::new(kernel, Grid::Collocated, h, &xs[k]).map(|s| stencils[k] = s)
                 };
+                debug_assert!(done >> k & 1 == 1 || st.is_err());
             }
             match self.faces {
                 // SAFETY: `g2p_update`'s contract.
@@ -204,7 +212,7 @@ where
                     sample_lanes::<T, R, D, K>(
                         self.material,
                         self.args,
-                        (&stencils, len),
+                        (&stencils, &lane_stencils, len),
                         self.view,
                         &mut status,
                         &mut cs,
@@ -377,7 +385,8 @@ where
 }
 
 /// The grid samples of the chunk's first `len` particles on the collocated grid (their
-/// `stencils`), one particle per lane of `R`, written to `cs`: the velocity sums of
+/// `stencils`, and the same on lanes, `lanes`, for every lane whose stencil is `Ok` in
+/// `status`), one particle per lane of `R`, written to `cs`: the velocity sums of
 /// [`chunk_field_sums`]; with heat on each particle's temperature pair ([`pair_sums`], or for a
 /// chunk whose eight particles all sample, [`chunk_sums`] of their
 /// [`pair_products`] where the row type transposes in registers: the same bits); then
@@ -393,7 +402,7 @@ where
 unsafe fn sample_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: usize>(
     material: &Material<T>,
     args: &G2pArgs<T>,
-    (stencils, len): (&[Stencil<T, D>; CHUNK], usize),
+    (stencils, lanes, len): (&[Stencil<T, D>; CHUNK], &StencilLanes<R>, usize),
     view: &G2pView<T, D>,
     status: &mut [Result<()>; CHUNK],
     cs: &mut ChunkSamples<T>,
@@ -464,13 +473,8 @@ unsafe fn sample_lanes<T: Real, R: Lane<Scalar = T>, const D: usize, const K: us
         }
     }
     // The velocity sums after the temperatures' (measured faster in this order).
-    let sm = chunk_field_sums::<T, R, D, K>(stencils, &rel, live, &view.velocity);
-    // The stencils' `fx` by axis, particle `l` in lane `l` (records of a stencil's size).
-    let mut fx = [z; 3];
-    debug_assert!(size_of::<Stencil<T, D>>() % size_of::<T>() == 0);
-    let rec = size_of::<Stencil<T, D>>() / size_of::<T>();
-    let fx0 = core::ptr::addr_of!((*stencils.as_ptr()).fx).cast::<T>();
-    R::load_records(fx0, rec, &mut fx[..D]);
+    let sm = chunk_field_sums::<T, R, D, K>(lanes, &rel, live, &view.velocity);
+    let fx = &lanes.fx;
     // As `sample_faces`: `v`, `C_p = (Σ w v oᵀ − v fxᵀ)/(κ h)`, `∇v`, every one finite.
     let inv = R::splat(inv_kh);
     let mut ok = z.eq(z);

@@ -3,7 +3,7 @@
 //! `Σ_i w_i u_i`, the gradient `Σ_i u_i ∇w_iᵀ` and the moments `Σ_i w_i u_i o_iᵀ` (`o` the
 //! node offset from the stencil base), every lane its own particle.
 //!
-//! **Order.** With the tensor-product weights `w_i = Π_a w_a[o_a]` ([`Stencil`]), per node row
+//! **Order.** With the tensor-product weights `w_i = Π_a w_a[o_a]` ([`Stencil`](crate::particle::stencil::Stencil)), per node row
 //! (the `K` nodes that differ in axis 0 only; rows in order `o₂` outer, `o₁` inner; 2D has no
 //! `o₂`) and component `a`, first the row's axis-0 sums, each a product and then multiply-adds in
 //! `o₀` order: `S = Σ_{o₀} w₀[o₀] u`, `S′ = Σ_{o₀} dw₀[o₀] u`, `S° = Σ_{o₀ ≥ 1} (w₀[o₀] o₀) u`;
@@ -23,7 +23,7 @@
 use super::field_sums::first_node;
 use super::InChannel;
 use crate::lane::Lane;
-use crate::particle::stencil::Stencil;
+use crate::particle::stencil::StencilLanes;
 use crate::scalar::Real;
 
 /// Particles per chunk: the eight lanes of the row types.
@@ -41,39 +41,6 @@ pub(super) struct LaneSums<L, const D: usize> {
     pub chk: L,
 }
 
-/// The per-axis weights `w[a][o]` and derivatives `dw[a][o]` (1/m) of the lanes' stencils
-/// (`o < K`; the other entries 0).
-pub(super) struct LaneWeights<L> {
-    pub w: [[L; 4]; 3],
-    pub dw: [[L; 4]; 3],
-}
-
-impl<T: Real, L: Lane<Scalar = T>> LaneWeights<L> {
-    /// The weights of `stencils[0..LANES]`, stencil `l` in lane `l`.
-    #[inline(always)]
-    #[must_use]
-    pub fn of<const D: usize, const K: usize>(stencils: &[Stencil<T, D>; LANES]) -> Self {
-        debug_assert!(L::LANES == LANES && K <= 4);
-        let z = L::splat(T::ZERO);
-        let (mut w, mut dw) = ([[z; 4]; 3], [[z; 4]; 3]);
-        // Scalars per stencil: `Stencil` holds only `T`, `i32` and a one-byte enum (see
-        // `Stencil::new_lanes`).
-        let rec = size_of::<Stencil<T, D>>() / size_of::<T>();
-        let first = stencils.as_ptr();
-        for a in 0..D {
-            // SAFETY: `stencils` holds `LANES` records of `rec` scalars; field `w[a]` (`dw[a]`)
-            // of record 0 starts `rec·l` scalars before that of record `l`, and has 4 scalars.
-            unsafe {
-                let pw = core::ptr::addr_of!((*first).w[a]).cast::<T>();
-                let pd = core::ptr::addr_of!((*first).dw[a]).cast::<T>();
-                L::load_records(pw, rec, &mut w[a][..K]);
-                L::load_records(pd, rec, &mut dw[a][..K]);
-            }
-        }
-        Self { w, dw }
-    }
-}
-
 /// The [`LaneSums`] of the field `ch` (components `0..d`) for the lanes' stencils with weights
 /// `wt`: `first[a][l]` is lane `l`'s first stencil node in channel `a` (node offset 0 on every
 /// axis), in the order of the module docs.
@@ -87,7 +54,7 @@ pub(super) unsafe fn lane_field_sums<
     const D: usize,
     const K: usize,
 >(
-    wt: &LaneWeights<L>,
+    wt: &StencilLanes<L>,
     ch: &[InChannel<T, D>; D],
     first: &[[*const T; LANES]; D],
 ) -> LaneSums<L, D> {
@@ -166,7 +133,7 @@ pub(super) unsafe fn lane_field_sums<
     s
 }
 
-/// [`lane_field_sums`] of the chunk's particles (`stencils`, box-relative bases `rel`) whose
+/// [`lane_field_sums`] of the chunk's particles (weights `wt`, box-relative bases `rel`) whose
 /// bit is set in `live` (not 0), lane `l` particle `l`; a lane not in `live` reads the nodes
 /// of the first lane that is (its sums are not used).
 ///
@@ -179,7 +146,7 @@ pub(super) unsafe fn chunk_field_sums<
     const D: usize,
     const K: usize,
 >(
-    stencils: &[Stencil<T, D>; LANES],
+    wt: &StencilLanes<L>,
     rel: &[[isize; D]; LANES],
     live: u32,
     ch: &[InChannel<T, D>; D],
@@ -204,8 +171,7 @@ pub(super) unsafe fn chunk_field_sums<
             }
         }
     }
-    let wt = LaneWeights::<L>::of::<D, K>(stencils);
-    lane_field_sums::<T, L, D, K>(&wt, ch, &first)
+    lane_field_sums::<T, L, D, K>(wt, ch, &first)
 }
 
 #[cfg(test)]

@@ -42,7 +42,7 @@ mod update_lanes;
 
 pub use crate::kernel::batch::BatchStatus;
 
-use super::stencil::{Grid, Kernel, Stencil};
+use super::stencil::{Grid, Kernel, Stencil, StencilLanes};
 use super::{Material, Particle, Phase};
 use crate::error::{Error, Result};
 use crate::mat::Mat;
@@ -197,6 +197,7 @@ unsafe fn wr<T: Copy>(p: *mut T, i: usize, v: T) {
 /// row of lanes (`xs.len() == R::LANES`). Returns the lanes whose stencil is done (see
 /// [`Stencil::new_lanes`]; none otherwise): the caller builds the others with
 /// [`Stencil::new`], which gives their errors. Entries from `len` on are left as they are.
+/// With `lanes`, the lane vectors of the stencils too (see [`Stencil::new_lanes`]).
 ///
 /// # Safety
 /// `x` holds particles `start..start + len`; `len ≤ xs.len() = out.len()`.
@@ -208,12 +209,13 @@ unsafe fn chunk_stencils<T: Real, R: crate::lane::Lane<Scalar = T>, const D: usi
     (start, len): (usize, usize),
     xs: &mut [[T; D]],
     out: &mut [Stencil<T, D>],
+    lanes: Option<&mut StencilLanes<R>>,
 ) -> u64 {
     for (k, xk) in xs.iter_mut().enumerate().take(len) {
         *xk = rd_vec::<T, D>(x, start + k);
     }
     if xs.len() == R::LANES {
-        Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, xs, out)
+        Stencil::new_lanes::<R>(kernel, Grid::Collocated, h, xs, out, lanes)
     } else {
         0
     }

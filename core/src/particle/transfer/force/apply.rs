@@ -130,7 +130,15 @@ where
             let len = TILE_X.min(self.n - start);
             // SAFETY: `apply`'s contract (particles `start..start + len` of `n`).
             let done = unsafe {
-                chunk_stencils::<T, R, D>(kernel, h, self.x, (start, len), &mut xs, &mut stencils)
+                chunk_stencils::<T, R, D>(
+                    kernel,
+                    h,
+                    self.x,
+                    (start, len),
+                    &mut xs,
+                    &mut stencils,
+                    None,
+                )
             };
             for k in 0..len {
                 // SAFETY: as above.

@@ -4,10 +4,10 @@
 //! sum within a rounding bound derived from their operation count; a value read that is not
 //! finite shows in exactly the lanes that read it.
 
-use super::{lane_field_sums, LaneSums, LaneWeights, LANES};
+use super::{lane_field_sums, LaneSums, LANES};
 use crate::kernel::batch::{dispatch, BatchReal};
 use crate::lane::{Isa, Lane};
-use crate::particle::stencil::{Grid, Kernel, Stencil};
+use crate::particle::stencil::{Grid, Kernel, Stencil, StencilLanes};
 use crate::particle::transfer::field_sums::first_node;
 use crate::particle::transfer::nodes::rel_base;
 use crate::particle::transfer::row_check::{ByRows, RowCheck};
@@ -99,7 +99,7 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
                 first[a][k] = first_node(&ch[a], &rel);
             }
         }
-        let wt = LaneWeights::<L>::of::<D, K>(&s);
+        let wt = StencilLanes::<L>::of::<D, K>(&s);
         (lane_field_sums::<T, L, D, K>(&wt, ch, &first), s)
     }
 

@@ -489,7 +489,7 @@ where
             for l in len..lanes {
                 b.blank_lane::<D>(l);
             }
-            let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils);
+            let done = Stencil::new_lanes::<V>(kernel, grid, h, &xs[..lanes], &mut stencils, None);
             let mut lane_err: [Option<Error>; L] = [None; L];
             // The deviatoric Kirchhoff stress Â F_Eᵀ of every lane (zero where μ = 0).
             let mut tau: LMat<V, D> = [[V::splat(T::ZERO); D]; D];
