@@ -3,9 +3,9 @@
 //! `Σ_i w_i u_i`, the gradient `Σ_i u_i ∇w_iᵀ` and the moments `Σ_i w_i u_i o_iᵀ` (`o` the
 //! node offset from the stencil base), every lane its own particle.
 //!
-//! **Order.** With the tensor-product weights `w_i = Π_a w_a[o_a]` ([`Stencil`](crate::particle::stencil::Stencil)), per node row
-//! (the `K` nodes that differ in axis 0 only; rows in order `o₂` outer, `o₁` inner; 2D has no
-//! `o₂`) and component `a`, first the row's axis-0 sums, each a product and then multiply-adds in
+//! **Order.** With the tensor-product weights `w_i = Π_a w_a[o_a]`
+//! ([`Stencil`](crate::particle::stencil::Stencil)), per node row (the `K` nodes that differ in
+//! axis 0 only; rows in order `o₂` outer, `o₁` inner; 2D has no `o₂`) and component `a`, first the row's axis-0 sums, each a product and then multiply-adds in
 //! `o₀` order: `S = Σ_{o₀} w₀[o₀] u`, `S′ = Σ_{o₀} dw₀[o₀] u`, `S° = Σ_{o₀ ≥ 1} (w₀[o₀] o₀) u`;
 //! then, with the row factors `c = w₁ w₂` (2D: `w₁`), `c₁ = dw₁ w₂`, `c₂ = w₁ dw₂`, one
 //! multiply-add per output into sums that start at 0: `Σ w u += c S`, `G_{a0} += c S′`,
