@@ -5,8 +5,9 @@
 //!
 //! **Order.** With the tensor-product weights `w_i = Π_a w_a[o_a]`
 //! ([`Stencil`](crate::particle::stencil::Stencil)), per node row (the `K` nodes that differ in
-//! axis 0 only; rows in order `o₂` outer, `o₁` inner; 2D has no `o₂`) and component `a`, first the row's axis-0 sums, each a product and then multiply-adds in
-//! `o₀` order: `S = Σ_{o₀} w₀[o₀] u`, `S′ = Σ_{o₀} dw₀[o₀] u`, `S° = Σ_{o₀ ≥ 1} (w₀[o₀] o₀) u`;
+//! axis 0 only; rows in order `o₂` outer, `o₁` inner; 2D has no `o₂`) and component `a`, first
+//! the row's axis-0 sums, each a product and then multiply-adds in `o₀` order:
+//! `S = Σ_{o₀} w₀[o₀] u`, `S′ = Σ_{o₀} dw₀[o₀] u`, `S° = Σ_{o₀ ≥ 1} (w₀[o₀] o₀) u`;
 //! then, with the row factors `c = w₁ w₂` (2D: `w₁`), `c₁ = dw₁ w₂`, `c₂ = w₁ dw₂`, one
 //! multiply-add per output into sums that start at 0: `Σ w u += c S`, `G_{a0} += c S′`,
 //! `G_{a1} += c₁ S`, `G_{a2} += c₂ S`, moment `a0 += c S°`, `a1 += (c o₁) S` (`o₁ ≥ 1`),

@@ -197,7 +197,7 @@ unsafe fn wr<T: Copy>(p: *mut T, i: usize, v: T) {
 /// row of lanes (`xs.len() == R::LANES`). Returns the lanes whose stencil is done (see
 /// [`Stencil::new_lanes`]; none otherwise): the caller builds the others with
 /// [`Stencil::new`], which gives their errors. Entries from `len` on are left as they are.
-/// With `lanes`, the lane vectors of the stencils too (see [`Stencil::new_lanes`]).
+/// With `lanes`, the lane vectors of the done stencils too (see [`Stencil::new_lanes`]).
 ///
 /// # Safety
 /// `x` holds particles `start..start + len`; `len ≤ xs.len() = out.len()`.
