@@ -1466,10 +1466,14 @@ struct AbFns {
         apply(l.sym<decltype(apply)>(A::apply_sym)) {}
 };
 
-/// One A/B row: medians (ns per particle) of both builds.
+/// The calls an A/B row times, in its columns' order.
+constexpr const char* kAbCalls[] = {"lib", "prepare", "apply"};
+constexpr int kAbN = sizeof kAbCalls / sizeof kAbCalls[0];
+
+/// One A/B row: medians (ns per particle) of both builds, per call of kAbCalls.
 struct AbRow {
   std::string scene, kase, isa;
-  double lib[2] = {NAN, NAN}, prepare[2] = {NAN, NAN}, apply[2] = {NAN, NAN};
+  double t[kAbN][2] = {};
 };
 
 /// Times one case on instruction set `isa` with both builds alternately (see the header).
@@ -1519,7 +1523,7 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   if (!same(grid[0], grid[1]) || !same(parts[0], parts[1]) || !same(slots[0], slots[1]) || !same(df[0], df[1]) ||
       phase[0] != phase[1])
     fail(cs.label("results") + " on " + isa_name(isa) + ": the two builds differ");
-  std::vector<double> lib[2], prep[2], app[2];
+  std::vector<double> times[kAbN][2];  // per call of kAbCalls and build
   for (int r = -1; r < reps; ++r) {
     for (int j = 0; j < 2; ++j) {
       const int k = (r + j + 2) % 2;
@@ -1539,9 +1543,9 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
       apply(k);
       const auto t6 = clock();
       if (r >= 0) {
-        lib[k].push_back(ns(t0, t1) + ns(t2, t3));
-        prep[k].push_back(ns(t4, t5));
-        app[k].push_back(ns(t5, t6));
+        times[0][k].push_back(ns(t0, t1) + ns(t2, t3));
+        times[1][k].push_back(ns(t4, t5));
+        times[2][k].push_back(ns(t5, t6));
       }
     }
   }
@@ -1552,12 +1556,12 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   };
   AbRow row;
   row.scene = scene_name(s), row.kase = Api<T, D>::name, row.isa = isa_name(isa);
-  for (int k = 0; k < 2; ++k)
-    row.lib[k] = median(lib[k]), row.prepare[k] = median(prep[k]), row.apply[k] = median(app[k]);
-  std::fprintf(stderr, "%-14s %s %-8s lib %6.1f / %6.1f (%.3f)  prepare %6.1f / %6.1f (%.3f)  apply %6.1f / %6.1f (%.3f)\n",
-               row.scene.c_str(), row.kase.c_str(), row.isa.c_str(), row.lib[0], row.lib[1], row.lib[1] / row.lib[0],
-               row.prepare[0], row.prepare[1], row.prepare[1] / row.prepare[0], row.apply[0], row.apply[1],
-               row.apply[1] / row.apply[0]);
+  std::fprintf(stderr, "%-14s %s %-8s", row.scene.c_str(), row.kase.c_str(), row.isa.c_str());
+  for (int c = 0; c < kAbN; ++c) {
+    for (int k = 0; k < 2; ++k) row.t[c][k] = median(times[c][k]);
+    std::fprintf(stderr, "  %s %6.1f / %6.1f (%.3f)", kAbCalls[c], row.t[c][0], row.t[c][1], row.t[c][1] / row.t[c][0]);
+  }
+  std::fputc('\n', stderr);
   rows.push_back(row);
 }
 
@@ -1574,19 +1578,22 @@ int run_ab(const std::string& a, const std::string& b, int reps) {
   std::ostringstream o;
   o << "A/B (bench_transfers --ab, " << reps << " reps, alternating): A = `" << a << "`, B = `" << b << "`\n"
     << "CPU: " << cpu_model() << "; load before: " << load_average() << "\n\n"
-    << "| scene | case | ISA | lib A | lib B | B / A | prepare A | prepare B | B / A | apply A | apply B | B / A |\n"
-    << "|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+    << "| scene | case | ISA |";
+  for (const char* c : kAbCalls) o << " " << c << " A | " << c << " B | B / A |";
+  o << "\n|---|---|---|";
+  for (int c = 0; c < kAbN; ++c) o << "---|---|---|";
+  o << "\n";
   char buf[64];
   auto num = [&](double x, const char* f) {
     std::snprintf(buf, sizeof buf, f, x);
     return std::string(buf);
   };
-  for (const AbRow& r : rows)
-    o << "| " << r.scene << " | " << r.kase << " | " << r.isa << " | " << num(r.lib[0], "%.1f") << " | "
-      << num(r.lib[1], "%.1f") << " | " << num(r.lib[1] / r.lib[0], "%.3f") << " | " << num(r.prepare[0], "%.1f")
-      << " | " << num(r.prepare[1], "%.1f") << " | " << num(r.prepare[1] / r.prepare[0], "%.3f") << " | "
-      << num(r.apply[0], "%.1f")
-      << " | " << num(r.apply[1], "%.1f") << " | " << num(r.apply[1] / r.apply[0], "%.3f") << " |\n";
+  for (const AbRow& r : rows) {
+    o << "| " << r.scene << " | " << r.kase << " | " << r.isa << " |";
+    for (const auto& t : r.t)
+      o << " " << num(t[0], "%.1f") << " | " << num(t[1], "%.1f") << " | " << num(t[1] / t[0], "%.3f") << " |";
+    o << "\n";
+  }
   std::fputs(o.str().c_str(), stdout);
   return 0;
 }
