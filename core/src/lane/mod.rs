@@ -92,17 +92,24 @@ pub trait Lane:
     /// # Safety
     /// Every such `base.add(i·stride)` is valid for writing; `i·stride < 2³¹`.
     unsafe fn scatter(self, base: *mut Self::Scalar, stride: usize, keep: u32);
-    /// One short node row per lane, transposed: `out[o]` lane `i` is `*p[i].offset(o·s0)` for
-    /// `o < K ≤ 4` (lanes `K..4` of `out` are 0); `p.len() == LANES`. Scalar loads by default;
-    /// the eight-lane `f32` type loads each row as one masked 4-lane vector when `s0 = 1` and
-    /// transposes in registers (the same values).
+    /// One short node row per lane, transposed: `out[o]` lane `i` is
+    /// `*base.offset(idx[i] + o·s0)` for `o < K ≤ 4` (lanes `K..4` of `out` are 0);
+    /// `idx.len() == LANES`. A base pointer and per-lane offsets (scalars), so that a caller
+    /// that reads several rows of the same lanes forms no per-lane pointers: each read is
+    /// addressed as base plus a lane's offset. Scalar loads by default; the eight-lane `f32`
+    /// type loads each row as one masked 4-lane vector when `s0 = 1` and transposes in
+    /// registers (the same values).
     ///
     /// # Safety
-    /// Every `p[i].offset(o·s0)`, `i < LANES`, `o < K`, is valid for reading.
+    /// Every `base.offset(idx[i] + o·s0)`, `i < LANES`, `o < K`, is valid for reading.
     #[inline(always)]
     #[must_use]
-    unsafe fn load_rows<const K: usize>(p: &[*const Self::Scalar], s0: isize) -> [Self; 4] {
-        load_rows_scalar::<Self, K>(p, s0)
+    unsafe fn load_rows<const K: usize>(
+        base: *const Self::Scalar,
+        idx: &[isize],
+        s0: isize,
+    ) -> [Self; 4] {
+        load_rows_scalar::<Self, K>(base, idx, s0)
     }
     /// Structure-of-arrays view of `LANES` consecutive records of `rec` scalars: `out[c]`
     /// lane `i` is `*base.add(i·rec + c)` for `c < out.len() ≤ rec` (a particle array of
@@ -349,14 +356,15 @@ impl<R: Lane> Pair<R> for X2<R> {
 /// As [`Lane::load_rows`].
 #[inline(always)]
 pub(crate) unsafe fn load_rows_scalar<L: Lane, const K: usize>(
-    p: &[*const L::Scalar],
+    base: *const L::Scalar,
+    idx: &[isize],
     s0: isize,
 ) -> [L; 4] {
-    debug_assert!(K <= 4 && p.len() == L::LANES && L::LANES <= 16);
+    debug_assert!(K <= 4 && idx.len() == L::LANES && L::LANES <= 16);
     let mut b = [[L::Scalar::ZERO; 16]; 4];
-    for (i, q) in p.iter().enumerate() {
+    for (i, &q) in idx.iter().enumerate() {
         for (o, bo) in b.iter_mut().enumerate().take(K) {
-            bo[i] = q.offset(o as isize * s0).read_unaligned();
+            bo[i] = base.offset(q + o as isize * s0).read_unaligned();
         }
     }
     [

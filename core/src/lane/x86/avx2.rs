@@ -120,10 +120,10 @@ impl Lane for F32x8 {
         _mm256_maskstore_ps(p, mask8(n), self.0)
     }
     #[inline(always)]
-    unsafe fn load_rows<const K: usize>(p: &[*const f32], s0: isize) -> [Self; 4] {
-        debug_assert!(K <= 4 && p.len() == 8);
+    unsafe fn load_rows<const K: usize>(base: *const f32, idx: &[isize], s0: isize) -> [Self; 4] {
+        debug_assert!(K <= 4 && idx.len() == 8);
         if s0 != 1 {
-            return load_rows_scalar::<Self, K>(p, s0);
+            return load_rows_scalar::<Self, K>(base, idx, s0);
         }
         // Row `i` in lanes 0..4 of a 128-bit load (lanes `K..4` masked off: not read), rows `i`
         // and `i + 4` in the two halves of one vector, then a 4 × 4 transpose within each half:
@@ -133,8 +133,8 @@ impl Lane for F32x8 {
         let m = _mm_setr_epi32(on[0], on[1], on[2], on[3]);
         let mut a = [_mm256_setzero_ps(); 4];
         for (i, ai) in a.iter_mut().enumerate() {
-            let lo = _mm256_castps128_ps256(_mm_maskload_ps(p[i], m));
-            *ai = _mm256_insertf128_ps::<1>(lo, _mm_maskload_ps(p[i + 4], m));
+            let lo = _mm256_castps128_ps256(_mm_maskload_ps(base.offset(idx[i]), m));
+            *ai = _mm256_insertf128_ps::<1>(lo, _mm_maskload_ps(base.offset(idx[i + 4]), m));
         }
         let [a0, a1, a2, a3] = a;
         let t0 = _mm256_unpacklo_ps(a0, a1);

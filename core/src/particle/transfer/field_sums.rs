@@ -259,11 +259,15 @@ unsafe fn contract<
     let (w, dw) = (&s.w, &s.dw);
     let pv = D.div_ceil(2);
     let o = |i: usize| T::from_i32(i as i32);
-    // The stencil's first node in each channel read.
+    // The stencil's first node in each channel read (with `SAME`, one offset for all).
+    let shared = node_offset(&ch[comps.0], rel);
     let mut p = [core::ptr::null::<T>(); D];
     for (a, pa) in p.iter_mut().enumerate() {
         if comps.0 <= a && a < comps.1 {
-            *pa = first_node(&ch[a], rel);
+            *pa = match SAME {
+                true => ch[a].data.offset(shared),
+                false => first_node(&ch[a], rel),
+            };
         }
     }
     // Σ x·0 over every vector read: NaN exactly when some value read is not finite (a
@@ -489,11 +493,18 @@ pub(super) unsafe fn first_node<T, const D: usize>(
     c: &InChannel<T, D>,
     rel: &[isize; D],
 ) -> *const T {
+    c.data.offset(node_offset(c, rel))
+}
+
+/// The offset (in scalars) from `c.data` of a stencil's first node (box-relative base `rel`)
+/// in channel `c`.
+#[inline(always)]
+pub(super) fn node_offset<T, const D: usize>(c: &InChannel<T, D>, rel: &[isize; D]) -> isize {
     let mut off = 0;
     for d in 0..D {
         off += rel[d] * c.stride[d];
     }
-    c.data.offset(off)
+    off
 }
 
 /// `f(o₀)` in lanes `o₀` and `4 + o₀` of a row vector (`o₀ < K`; the other lanes 0), put

@@ -17,11 +17,13 @@
 //!
 //! **Reads.** Each row of a lane is `K` scalars of one channel (axis-0 stride `s₀`); the rows of
 //! the eight lanes are loaded and transposed together ([`Lane::load_rows`]), so that no lane
-//! sum crosses lanes and no output is transposed afterwards. That the values read are finite
+//! sum crosses lanes and no output is transposed afterwards. A row is addressed as one base
+//! pointer (the channel's data plus the row's offset) plus each lane's offset of its first
+//! node, formed once per chunk: no per-lane pointers per row. That the values read are finite
 //! is tested as `Σ x·0` (NaN exactly when some value read by the lane is not finite), a few
 //! multiply-adds per row kept off the sums' chains.
 
-use super::field_sums::first_node;
+use super::field_sums::node_offset;
 use super::InChannel;
 use crate::lane::Lane;
 use crate::particle::stencil::StencilLanes;
@@ -43,8 +45,10 @@ pub(super) struct LaneSums<L, const D: usize> {
 }
 
 /// The [`LaneSums`] of the field `ch` (components `0..d`) for the lanes' stencils with weights
-/// `wt`: `first[a][l]` is lane `l`'s first stencil node in channel `a` (node offset 0 on every
-/// axis), in the order of the module docs.
+/// `wt`: `first[a][l]` is the offset (in scalars) from `ch[a].data` of lane `l`'s first
+/// stencil node in channel `a` (node offset 0 on every axis), in the order of the module docs.
+/// `SAME`: every channel has the strides of channel 0 and `first[0]` serves every channel
+/// (the others are not read).
 ///
 /// # Safety
 /// Every node of every lane's stencil is valid for reading in each channel.
@@ -54,10 +58,11 @@ pub(super) unsafe fn lane_field_sums<
     L: Lane<Scalar = T>,
     const D: usize,
     const K: usize,
+    const SAME: bool,
 >(
     wt: &StencilLanes<L>,
     ch: &[InChannel<T, D>; D],
-    first: &[[*const T; LANES]; D],
+    first: &[[isize; LANES]; D],
 ) -> LaneSums<L, D> {
     debug_assert!(L::LANES == LANES && K <= 4 && (D == 2 || D == 3));
     let z = L::splat(T::ZERO);
@@ -89,16 +94,16 @@ pub(super) unsafe fn lane_field_sums<
                 (w[1][o1], dw[1][o1], z)
             };
             for a in 0..D {
-                let st = &ch[a].stride;
+                let (st, lanes) = match SAME {
+                    true => (&ch[0].stride, &first[0]),
+                    false => (&ch[a].stride, &first[a]),
+                };
                 let mut off = o1 as isize * st[1];
                 if D == 3 {
                     off += o2 as isize * st[D - 1];
                 }
-                let mut rows = [core::ptr::null::<T>(); LANES];
-                for (r, f) in rows.iter_mut().zip(&first[a]) {
-                    *r = f.wrapping_offset(off);
-                }
-                let u = L::load_rows::<K>(&rows, st[0]);
+                // Each lane's row: the row's base plus the lane's offset, no per-lane pointer.
+                let u = L::load_rows::<K>(ch[a].data.wrapping_offset(off), lanes, st[0]);
                 let mut zs = u[0] * z;
                 let mut sw = u[0] * w[0][0];
                 let mut sd = u[0] * dw[0][0];
@@ -154,25 +159,21 @@ pub(super) unsafe fn chunk_field_sums<
 ) -> LaneSums<L, D> {
     debug_assert!(live != 0);
     let fill = live.trailing_zeros() as usize;
-    // Channels with the same strides (separate arrays of one box, the usual layout) share
-    // each lane's node offset.
+    // Channels with the same strides (separate arrays of one box, the usual layout, or
+    // interleaved node structs) share each lane's node offset.
     let same = ch.iter().all(|c| c.stride == ch[0].stride);
-    let mut first = [[core::ptr::null::<T>(); LANES]; D];
+    let mut first = [[0isize; LANES]; D];
     for k in 0..LANES {
         let r = &rel[if live >> k & 1 == 1 { k } else { fill }];
-        if same {
-            let f0 = first_node(&ch[0], r);
-            let off = f0.offset_from(ch[0].data);
-            for (a, f) in first.iter_mut().enumerate() {
-                f[k] = ch[a].data.offset(off);
-            }
-        } else {
-            for (a, f) in first.iter_mut().enumerate() {
-                f[k] = first_node(&ch[a], r);
-            }
+        for (a, f) in first.iter_mut().enumerate().take(if same { 1 } else { D }) {
+            f[k] = node_offset(&ch[a], r);
         }
     }
-    lane_field_sums::<T, L, D, K>(wt, ch, &first)
+    if same {
+        lane_field_sums::<T, L, D, K, true>(wt, ch, &first)
+    } else {
+        lane_field_sums::<T, L, D, K, false>(wt, ch, &first)
+    }
 }
 
 #[cfg(test)]

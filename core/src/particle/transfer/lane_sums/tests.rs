@@ -8,7 +8,7 @@ use super::{lane_field_sums, LaneSums, LANES};
 use crate::kernel::batch::{dispatch, BatchReal};
 use crate::lane::{Isa, Lane};
 use crate::particle::stencil::{Grid, Kernel, Stencil, StencilLanes};
-use crate::particle::transfer::field_sums::first_node;
+use crate::particle::transfer::field_sums::node_offset;
 use crate::particle::transfer::nodes::rel_base;
 use crate::particle::transfer::row_check::{ByRows, RowCheck};
 use crate::particle::transfer::{InChannel, NodeBox};
@@ -92,15 +92,22 @@ impl<T: Real, const D: usize> Check<'_, T, D> {
         let s: [Stencil<T, D>; LANES] = core::array::from_fn(|k| {
             Stencil::new(self.kernel, Grid::Collocated, T::ONE, &self.data.xs[idx[k]]).unwrap()
         });
-        let mut first = [[core::ptr::null::<T>(); LANES]; D];
+        let mut first = [[0isize; LANES]; D];
         for (k, st) in s.iter().enumerate() {
             let rel = rel_base(st, &nodes).unwrap();
             for a in 0..D {
-                first[a][k] = first_node(&ch[a], &rel);
+                first[a][k] = node_offset(&ch[a], &rel);
             }
         }
         let wt = StencilLanes::<L>::of::<D, K>(&s);
-        (lane_field_sums::<T, L, D, K>(&wt, ch, &first), s)
+        // Both layouts have one stride set for every channel: the sums that share channel 0's
+        // offsets and the ones that read each channel's are the same.
+        let own = lane_field_sums::<T, L, D, K, false>(&wt, ch, &first);
+        let shared = lane_field_sums::<T, L, D, K, true>(&wt, ch, &first);
+        for k in 0..LANES {
+            assert_eq!(bits(&lane(&own, k)), bits(&lane(&shared, k)));
+        }
+        (own, s)
     }
 
     fn rows_on<L: Lane<Scalar = T>, const K: usize>(&mut self) {
