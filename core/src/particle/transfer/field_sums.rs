@@ -260,14 +260,20 @@ unsafe fn contract<
     let pv = D.div_ceil(2);
     let o = |i: usize| T::from_i32(i as i32);
     // The stencil's first node in each channel read (with `SAME`, one offset for all).
-    let shared = node_offset(&ch[comps.0], rel);
+    let shared = if SAME {
+        node_offset(&ch[comps.0], rel)
+    } else {
+        0
+    };
     let mut p = [core::ptr::null::<T>(); D];
     for (a, pa) in p.iter_mut().enumerate() {
         if comps.0 <= a && a < comps.1 {
-            *pa = match SAME {
-                true => ch[a].data.offset(shared),
-                false => first_node(&ch[a], rel),
+            let off = if SAME {
+                shared
+            } else {
+                node_offset(&ch[a], rel)
             };
+            *pa = ch[a].data.offset(off);
         }
     }
     // Σ x·0 over every vector read: NaN exactly when some value read is not finite (a
