@@ -27,7 +27,9 @@ use crate::scalar::Real;
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, BitAnd, BitOr, Div, Mul, MulAssign, Neg, Not, Sub, SubAssign};
 
+mod isa;
 pub mod lmat;
+pub use isa::{Isa, IsaKind};
 mod x2;
 pub use x2::{X2Mask, X2};
 #[cfg(target_arch = "x86_64")]
@@ -515,138 +517,6 @@ impl<T: Real> Lane for T {
     fn pow2(e: T) -> T {
         T::pow2i(e.to_f64() as i32)
     }
-}
-
-/// The instruction sets of the batch kernels, widest first. A value other than
-/// [`Isa::SCALAR`] is a promise that the CPU supports it: create it with `Isa::detect` (with
-/// the `std` feature) or, unsafely, with [`Isa::assume`].
-///
-/// With AVX-512 it also says whether the particle transfers put two eight-lane rows in one
-/// sixteen-lane register ([`Isa::joined_rows`]): on by default where 512-bit operations run at
-/// the full rate of two 256-bit ones without slowing the rest (AMD Zen 5 and later), off
-/// elsewhere (on an Intel Xeon the joined rows measured 7–13% slower).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Isa(IsaKind, bool);
-
-/// What an [`Isa`] names.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum IsaKind {
-    /// One particle at a time (`f32`/`f64` lanes); every target.
-    Scalar,
-    /// x86-64 AVX2 + FMA: `f32×8`, `f64×4`.
-    Avx2,
-    /// x86-64 AVX-512 F, VL, DQ and BW (+ AVX2 + FMA): `f32×16`, `f64×8`. The particle
-    /// transfers' eight-lane rows are built with VL (32 registers, k-masked moves; see
-    /// `LaneOp::AVX512_VL`), the kernels with AVX-512F alone.
-    Avx512,
-}
-
-impl Isa {
-    /// The scalar path, available everywhere.
-    pub const SCALAR: Isa = Isa(IsaKind::Scalar, false);
-
-    /// What this value names.
-    #[inline]
-    #[must_use]
-    pub fn kind(self) -> IsaKind {
-        self.0
-    }
-
-    /// Short name for reports: "scalar", "avx2", "avx512".
-    #[inline]
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self.0 {
-            IsaKind::Scalar => "scalar",
-            IsaKind::Avx2 => "avx2",
-            IsaKind::Avx512 => "avx512",
-        }
-    }
-
-    /// This instruction set, or AVX2 in place of AVX-512 (which implies it): for loops whose
-    /// AVX-512 build is slower than their AVX2 build.
-    #[inline]
-    #[must_use]
-    pub fn at_most_avx2(self) -> Isa {
-        match self.0 {
-            IsaKind::Avx512 => Isa(IsaKind::Avx2, false),
-            _ => self,
-        }
-    }
-
-    /// Whether the particle transfers (P2G, the force differential's apply) sum two eight-lane
-    /// node rows in one sixteen-lane register: AVX-512 `f32` in 3D. The same bits either way,
-    /// but for the sign of a zero node sum (see `particle/transfer/tile.rs`).
-    #[inline]
-    #[must_use]
-    pub fn joined_rows(self) -> bool {
-        self.1
-    }
-
-    /// This instruction set with joined rows on or off ([`Isa::joined_rows`]; always off for
-    /// instruction sets other than AVX-512, whose instructions they use).
-    #[inline]
-    #[must_use]
-    pub fn with_joined_rows(self, on: bool) -> Isa {
-        Isa(self.0, on && self.0 == IsaKind::Avx512)
-    }
-
-    /// An [`Isa`] of the given kind without checking the CPU (rows not joined).
-    ///
-    /// # Safety
-    /// The CPU running every kernel called with the result must support the kind's
-    /// instructions (AVX2 and FMA; for [`IsaKind::Avx512`] also AVX-512 F, VL, DQ and BW).
-    #[inline]
-    #[must_use]
-    pub const unsafe fn assume(kind: IsaKind) -> Isa {
-        Isa(kind, false)
-    }
-
-    /// The widest instruction set of this CPU (detected at run time).
-    #[cfg(feature = "std")]
-    #[inline]
-    #[must_use]
-    pub fn detect() -> Isa {
-        Self::available().last().copied().unwrap_or(Isa::SCALAR)
-    }
-
-    /// Every instruction set this CPU supports, scalar first (for tests and benchmarks).
-    #[cfg(feature = "std")]
-    #[must_use]
-    pub fn available() -> std::vec::Vec<Isa> {
-        let mut v = std::vec![Isa::SCALAR];
-        #[cfg(target_arch = "x86_64")]
-        {
-            if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                v.push(Isa(IsaKind::Avx2, false));
-                if std::is_x86_feature_detected!("avx512f")
-                    && std::is_x86_feature_detected!("avx512vl")
-                    && std::is_x86_feature_detected!("avx512dq")
-                    && std::is_x86_feature_detected!("avx512bw")
-                {
-                    v.push(Isa(IsaKind::Avx512, full_rate_512()));
-                }
-            }
-        }
-        v
-    }
-}
-
-/// Whether this CPU runs 512-bit vector operations at the rate of two 256-bit ones without
-/// slowing the rest: AMD family 1Ah (Zen 5) and later. Intel's server cores fuse two ports for
-/// 512-bit operations, and Zen 4 splits them into two 256-bit halves.
-#[cfg(all(feature = "std", target_arch = "x86_64"))]
-fn full_rate_512() -> bool {
-    use core::arch::x86_64::__cpuid;
-    let (v, f) = (__cpuid(0), __cpuid(1));
-    let amd = (v.ebx, v.edx, v.ecx) == (0x6874_7541, 0x6974_6e65, 0x444d_4163);
-    let base = (f.eax >> 8) & 0xf;
-    let family = if base == 0xf {
-        base + ((f.eax >> 20) & 0xff)
-    } else {
-        base
-    };
-    amd && family >= 0x1a
 }
 
 #[cfg(all(test, feature = "std"))]
