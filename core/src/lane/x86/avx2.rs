@@ -310,8 +310,7 @@ impl Lane for F32x8 {
 /// of `x·2²⁴` / 3 + B2, with `x`'s sign), then two Newton steps
 /// `t ← t (x + x + t³) / (x + t³ + t³)` in `f64` from `x` itself, rounded to `f32` (to
 /// nearest, as `as f32`); `±0` and non-finite `x` as `cbrtf` (`x`, `x + x`). The integer
-/// quotient `bits / 3` is `⌊bits / 3.0⌋` in `f64`: exact, since `bits < 2³¹` and `bits/3` is
-/// an integer or at least 1/3 away from one.
+/// quotient `bits / 3` is formed by a multiply-high ([`third8`]).
 ///
 /// # Safety
 /// AVX2 available.
@@ -327,10 +326,7 @@ unsafe fn cbrt8(x: __m256) -> __m256 {
     let hs = _mm256_and_si256(scaled, _mm256_set1_epi32(i32::MAX));
     let h = _mm256_blendv_epi8(hx, hs, sub);
     let b = _mm256_blendv_epi8(_mm256_set1_epi32(B1), _mm256_set1_epi32(B2), sub);
-    let quot = _mm256_set_m128i(
-        third4(_mm256_extracti128_si256::<1>(h)),
-        third4(_mm256_castsi256_si128(h)),
-    );
+    let quot = third8(h);
     let t0 = _mm256_castsi256_ps(_mm256_or_si256(sign, _mm256_add_epi32(quot, b)));
     // Helper functions, not closures: a closure is not compiled with the caller's target
     // features.
@@ -347,14 +343,22 @@ unsafe fn cbrt8(x: __m256) -> __m256 {
     _mm256_blendv_ps(y, x, _mm256_castsi256_ps(zero))
 }
 
-/// `⌊v / 3⌋` of four non-negative 32-bit integers, through `f64` (exact, see [`cbrt8`]).
+/// `⌊v / 3⌋` of eight 32-bit integers `v < 2³¹`, as `(v · 0xAAAAAAAB) >> 33` in 64 bits
+/// (division by an invariant integer, Granlund and Montgomery 1994): `3 · 0xAAAAAAAB =
+/// 2³³ + 1`, so the product over `2³³` is `v/3 + v/(3 · 2³³)`, whose excess is below 1/3 and
+/// cannot carry `v/3` (fraction at most 2/3) past the next integer. The even lanes from one
+/// `32 × 32 → 64`-bit product, the odd lanes from another, instead of an `f64` division.
 ///
 /// # Safety
 /// AVX2 available.
 #[inline(always)]
-unsafe fn third4(v: __m128i) -> __m128i {
-    let d = _mm256_div_pd(_mm256_cvtepi32_pd(v), _mm256_set1_pd(3.0));
-    _mm256_cvttpd_epi32(_mm256_floor_pd(d))
+unsafe fn third8(v: __m256i) -> __m256i {
+    let m = _mm256_set1_epi64x(0xAAAA_AAAB);
+    let even = _mm256_srli_epi64::<33>(_mm256_mul_epu32(v, m));
+    // The odd lanes' quotients, shifted to the high halves: (p >> 33) << 32 = (p >> 1) with
+    // its low 32 bits dropped by the blend.
+    let odd = _mm256_srli_epi64::<1>(_mm256_mul_epu32(_mm256_srli_epi64::<32>(v), m));
+    _mm256_blend_epi32::<0b1010_1010>(even, odd)
 }
 
 /// The two Newton steps of [`cbrt8`] on four lanes: guess `t`, argument `x`.
