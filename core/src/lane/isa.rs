@@ -86,7 +86,8 @@ impl Isa {
         Isa(kind, false)
     }
 
-    /// The widest instruction set of this CPU (detected at run time).
+    /// The widest instruction set of this CPU (detected at run time). Detection runs `cpuid`,
+    /// which a virtual machine traps (microseconds per call): detect once and keep the value.
     #[cfg(feature = "std")]
     #[inline]
     #[must_use]
