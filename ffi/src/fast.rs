@@ -18,13 +18,12 @@ use std::sync::atomic::{AtomicU8, Ordering};
 /// traps (7.6 µs measured on a cloud VM, as long as P2G and G2P of about 100 particles).
 static ISA: AtomicU8 = AtomicU8::new(0);
 
+/// The [`IsaKind`]s in the order of their `AMPM_ISA_*` values (0, 1, 2).
+const KINDS: [IsaKind; 3] = [IsaKind::Scalar, IsaKind::Avx2, IsaKind::Avx512];
+
 /// `AMPM_ISA_*` value of an [`IsaKind`].
 fn code(k: IsaKind) -> u32 {
-    match k {
-        IsaKind::Scalar => 0,
-        IsaKind::Avx2 => 1,
-        IsaKind::Avx512 => 2,
-    }
+    KINDS.iter().position(|&x| x == k).unwrap_or(0) as u32
 }
 
 /// `1 + AMPM_ISA_*` in bits 0–1, [`Isa::joined_rows`] in bit 2 (never 0).
@@ -34,11 +33,7 @@ fn encode(i: Isa) -> u8 {
 
 /// The [`Isa`] of a non-zero [`encode`] value.
 fn decode(c: u8) -> Isa {
-    let kind = match c & 3 {
-        2 => IsaKind::Avx2,
-        3 => IsaKind::Avx512,
-        _ => IsaKind::Scalar,
-    };
+    let kind = KINDS[usize::from(c & 3).saturating_sub(1)];
     // SAFETY: every value stored in `ISA` encodes an `Isa` that `Isa::available` returned, so
     // the CPU supports its instructions.
     unsafe { Isa::assume(kind) }.with_joined_rows(c & 4 != 0)
