@@ -49,6 +49,13 @@
 // the medians is reported (≈ 1.00 when the wrapper costs nothing). Before timing, and in
 // --check, the wrapper's step must give bit-identical grids and particles to the C step.
 //
+// Block calls (elastic and fluid 3D f32, elastic 2D f32, default instruction set): lib and apply
+// with the particles in calls of 4096, 512 and 64 consecutive particles (a threaded host's
+// blocks; every call into the same grid views) against one call, the sizes alternating rep by
+// rep; the report gives the ratio to one call and the cost per extra call. Before timing, G2P
+// in calls of 64 must leave the particles bit-identical to one call (a particle's result does
+// not depend on the batch it is in).
+//
 // --ab: two builds of the library (say, before and after a change) in one process, each
 // loaded from its own libampm.so with dlopen (its own copy of the library's state). For every
 // scene but snow, 3D and 2D f32, every instruction set both accept: lib (P2G sym + G2P, each
@@ -229,8 +236,14 @@ struct Parts {
   std::vector<std::uint8_t> ph;
   template <class U = T>
   typename Api<U, D>::Particles view() {
-    return {x.data(), v.data(), c.data(), fe.data(), fp.data(), m.data(), v0.data(),
-            t.data(), u.data(), ph.data()};
+    return view_at<U>(0);
+  }
+  /// The view of particles i.. (each array advanced by i records).
+  template <class U = T>
+  typename Api<U, D>::Particles view_at(std::size_t i) {
+    const std::size_t d = D, dd = D * D;
+    return {x.data() + i * d, v.data() + i * d, c.data() + i * dd, fe.data() + i * dd, fp.data() + i * dd,
+            m.data() + i, v0.data() + i, t.data() + i, u.data() + i, ph.data() + i};
   }
 };
 
@@ -754,6 +767,20 @@ struct Case {
   AmpmStatus apply(std::size_t* ff, decltype(A::apply) f = A::apply) {
     return f(AMPM_KERNEL_QUADRATIC, h, p.n, p.x.data(), slots.data(), &v.force, ff);
   }
+  // The same calls over particles [i, i + k) (a host's block of particles), with `ff` relative to i.
+  AmpmStatus p2g_sym_range(std::size_t i, std::size_t k, std::size_t* ff) {
+    const auto m = material<T, D>(scene, false);
+    auto pv = p.view_at(i);
+    return A::p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, k, &pv, &v.sym, ff);
+  }
+  AmpmStatus g2p_range(std::size_t i, std::size_t k, std::size_t* ff) {
+    const auto m = material<T, D>(scene, false);
+    auto pv = p.view_at(i);
+    return A::g2p(&m, AMPM_KERNEL_QUADRATIC, h, dt, k, &pv, &v.g2p, ff);
+  }
+  AmpmStatus apply_range(std::size_t i, std::size_t k, std::size_t* ff) {
+    return A::apply(AMPM_KERNEL_QUADRATIC, h, k, p.x.data() + i * D, slots.data() + i * A::slot_len, &v.force, ff);
+  }
   void zero_df() {
     for (int a = 0; a < D; ++a) std::fill(g.df[a].begin(), g.df[a].end(), T(0));
   }
@@ -1210,6 +1237,112 @@ HppTiming time_hpp(int per_axis, int reps) {
   return {cs.p.n, tc[tc.size() / 2], th[th.size() / 2], tc.front(), th.front()};
 }
 
+/// Particles per call of the block timing (0: the whole batch in one call).
+constexpr std::size_t kBlocks[] = {0, 4096, 512, 64};
+constexpr int kNumBlocks = sizeof kBlocks / sizeof kBlocks[0];
+
+/// Largest block whose per-call cost the report gives: above it the difference to one call is
+/// within the run-to-run spread.
+constexpr std::size_t kPerCallMax = 512;
+
+/// " (r)", a ratio to one call.
+std::string ratio_text(double r) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, " (%.2f)", r);
+  return buf;
+}
+
+/// A host's block calls (one call per range of particles, as a threaded host makes them):
+/// lib (P2G sym + G2P) and apply, medians in ns per particle for each size of kBlocks.
+struct BlockTiming {
+  std::string scene, kase;
+  std::size_t n = 0;
+  double lib[kNumBlocks] = {}, apply[kNumBlocks] = {};
+};
+
+/// `call(i, k, &ff)` over the particles of `cs` in calls of `b` (0: one call), in order; every
+/// call must return AMPM_OK.
+template <class C, class Call>
+void in_blocks(C& cs, std::size_t b, const char* what, Call&& call) {
+  const std::size_t n = cs.p.n, step = b == 0 ? n : b;
+  std::size_t ff = 0;
+  for (std::size_t i = 0; i < n; i += step) {
+    const std::size_t k = std::min(step, n - i);
+    const AmpmStatus st = call(i, k, &ff);
+    expect_ok(cs.label(what), st, ff, k);
+  }
+}
+
+/// G2P in calls of 64 particles leaves every particle bit-identical to one call (a particle's
+/// result does not depend on the batch it is in).
+template <class T, int D>
+void check_blocks(Scene s, int per_axis, CheckLog& log) {
+  Case<T, D> cs(s, per_axis);
+  auto g2p_state = [&](std::size_t b) {
+    cs.restore();
+    cs.g.zero_p2g();
+    in_blocks(cs, 0, "P2G sym", [&](std::size_t i, std::size_t k, std::size_t* f) { return cs.p2g_sym_range(i, k, f); });
+    grid_update(cs.g, cs.thermal);
+    in_blocks(cs, b, "G2P", [&](std::size_t i, std::size_t k, std::size_t* f) { return cs.g2p_range(i, k, f); });
+    std::vector<T> st;
+    for (const auto* f : {&cs.p.x, &cs.p.v, &cs.p.c, &cs.p.fe, &cs.p.fp, &cs.p.t, &cs.p.u})
+      st.insert(st.end(), f->begin(), f->end());
+    return st;
+  };
+  const std::vector<T> whole = g2p_state(0), small = g2p_state(64);
+  if (whole.size() != small.size() || std::memcmp(whole.data(), small.data(), whole.size() * sizeof(T)) != 0)
+    fail(cs.label("G2P in calls of 64") + ": particles differ from one call");
+  cs.restore();
+  log.add(cs.label("G2P") + ", " + std::to_string(cs.p.n) +
+          " particles in calls of 64: bit-identical particles to one call");
+}
+
+/// Times lib and apply of one case on the default instruction set, the particles in calls of
+/// kBlocks particles (consecutive ranges, every call into the same grid views), the sizes
+/// alternating rep by rep (one warm-up round) so that all see the same machine state.
+template <class T, int D>
+BlockTiming time_blocks(Scene s, int per_axis, int reps) {
+  Case<T, D> cs(s, per_axis);
+  cs.run_all_once();
+  const std::size_t n = cs.p.n;
+  auto blocks = [&](std::size_t b, const char* what, auto&& call) { in_blocks(cs, b, what, call); };
+  auto clock = [] { return std::chrono::steady_clock::now(); };
+  auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
+  std::vector<double> lib[kNumBlocks], apply[kNumBlocks];
+  for (int r = -1; r < reps; ++r)
+    for (int j = 0; j < kNumBlocks; ++j) {
+      const std::size_t b = kBlocks[j];
+      cs.restore();
+      cs.g.zero_p2g();
+      const auto t0 = clock();
+      blocks(b, "P2G sym", [&](std::size_t i, std::size_t k, std::size_t* f) { return cs.p2g_sym_range(i, k, f); });
+      const auto t1 = clock();
+      grid_update(cs.g, cs.thermal);
+      const auto t2 = clock();
+      blocks(b, "G2P", [&](std::size_t i, std::size_t k, std::size_t* f) { return cs.g2p_range(i, k, f); });
+      const auto t3 = clock();
+      cs.zero_df();
+      const auto t4 = clock();
+      blocks(b, "apply", [&](std::size_t i, std::size_t k, std::size_t* f) { return cs.apply_range(i, k, f); });
+      const auto t5 = clock();
+      if (r >= 0) lib[j].push_back(ns(t0, t1) + ns(t2, t3)), apply[j].push_back(ns(t4, t5));
+    }
+  cs.restore();
+  auto median = [](std::vector<double>& v) {
+    std::sort(v.begin(), v.end());
+    return v[v.size() / 2];
+  };
+  BlockTiming bt;
+  bt.scene = scene_name(s), bt.kase = Api<T, D>::name, bt.n = n;
+  for (int j = 0; j < kNumBlocks; ++j) bt.lib[j] = median(lib[j]), bt.apply[j] = median(apply[j]);
+  std::fprintf(stderr, "blocks %s %s: lib", bt.scene.c_str(), bt.kase.c_str());
+  for (int j = 0; j < kNumBlocks; ++j) std::fprintf(stderr, " %zu:%.1f", kBlocks[j], bt.lib[j]);
+  std::fprintf(stderr, ", apply");
+  for (int j = 0; j < kNumBlocks; ++j) std::fprintf(stderr, " %zu:%.1f", kBlocks[j], bt.apply[j]);
+  std::fputc('\n', stderr);
+  return bt;
+}
+
 std::string fmt(double ns) {
   if (std::isnan(ns)) return "n/a";
   char b[32];
@@ -1282,8 +1415,8 @@ std::string floor_report(const std::vector<Row>& rows, const Baseline& base, con
 }
 
 std::string report(const std::vector<Row>& rows, const Baseline& base, const std::vector<Floor>& floors,
-                   const HppTiming& hpp, const std::vector<std::string>& checks, int reps, std::uint32_t default_isa,
-                   const std::string& load_before) {
+                   const HppTiming& hpp, const std::vector<BlockTiming>& blocks, const std::vector<std::string>& checks,
+                   int reps, std::uint32_t default_isa, const std::string& load_before) {
   std::ostringstream o;
   o << "# ampm particle transfers in a host's step loop\n\n";
   o << "CPU: " << cpu_model() << "; default instruction set (`ampm_isa()`): " << isa_name(default_isa)
@@ -1348,6 +1481,32 @@ std::string report(const std::vector<Row>& rows, const Baseline& base, const std
   o << "| | step, C calls | step, ampm.hpp | ampm.hpp / C |\n|---|---:|---:|---:|\n";
   o << "| median | " << fmt(hpp.c) << " | " << fmt(hpp.hpp) << " | " << hr << " |\n";
   o << "| fastest run | " << fmt(hpp.c_min) << " | " << fmt(hpp.hpp_min) << " | " << hr_min << " |\n\n";
+  o << "Block calls (" << isa_name(default_isa)
+    << "): the same lib (P2G sym + G2P) and apply, each call over a range of consecutive particles (the "
+       "sorted order) into the same grid views, as a host that gives each thread its blocks makes them; "
+       "the sizes alternate rep by rep. ns per particle per step (ratio to one call); per call: the "
+       "difference to one call divided by the extra calls (lib: two calls per block), given for blocks of at "
+       "most " << kPerCallMax << " particles (above that the difference is within the spread between runs).\n\n";
+  o << "| scene | case | particles per call | lib | apply | per call, lib | per call, apply |\n"
+       "|---|---|---:|---:|---:|---:|---:|\n";
+  for (const BlockTiming& b : blocks)
+    for (int j = 0; j < kNumBlocks; ++j) {
+      char row[256];
+      const double calls = j == 0 ? 1.0 : std::ceil(static_cast<double>(b.n) / static_cast<double>(kBlocks[j]));
+      const double nn = static_cast<double>(b.n);
+      if (j == 0 || kBlocks[j] > kPerCallMax)
+        std::snprintf(row, sizeof row, "| %s | %s | %s | %s%s | %s%s | — | — |\n", b.scene.c_str(), b.kase.c_str(),
+                      j == 0 ? ("all (" + std::to_string(b.n) + ")").c_str() : std::to_string(kBlocks[j]).c_str(),
+                      fmt(b.lib[j]).c_str(), j == 0 ? "" : ratio_text(b.lib[j] / b.lib[0]).c_str(),
+                      fmt(b.apply[j]).c_str(), j == 0 ? "" : ratio_text(b.apply[j] / b.apply[0]).c_str());
+      else
+        std::snprintf(row, sizeof row, "| %s | %s | %zu | %s (%.2f) | %s (%.2f) | %.0f ns | %.0f ns |\n",
+                      b.scene.c_str(), b.kase.c_str(), kBlocks[j], fmt(b.lib[j]).c_str(), b.lib[j] / b.lib[0],
+                      fmt(b.apply[j]).c_str(), b.apply[j] / b.apply[0], (b.lib[j] - b.lib[0]) * nn / (2 * (calls - 1)),
+                      (b.apply[j] - b.apply[0]) * nn / (calls - 1));
+      o << row;
+    }
+  o << "\n";
   o << "Agreement checks (run before timing; `bench_transfers --check` runs them alone on 6³ / 14² blocks):\n\n";
   for (const std::string& c : checks) o << "- " << c << "\n";
   return o.str();
@@ -1656,6 +1815,10 @@ int main(int argc, char** argv) {
     check_isas<double, 2>(s, 14, isas, log);
   }
   ampm_set_isa(default_isa);
+  for (Scene s : kScenes) {
+    check_blocks<float, 3>(s, 6, log);
+    check_blocks<float, 2>(s, 14, log);
+  }
   check_hpp(6, log);
   if (check) {
     std::printf("bench_transfers --check: all results agree\n");
@@ -1682,7 +1845,11 @@ int main(int argc, char** argv) {
   const HppTiming hpp = time_hpp(n3, reps);
   std::fprintf(stderr, "ampm.hpp elastic 3D f32 step: C %.1f ns, ampm.hpp %.1f ns, ratio %.3f (fastest %.3f)\n", hpp.c,
                hpp.hpp, hpp.hpp / hpp.c, hpp.hpp_min / hpp.c_min);
-  const std::string text = report(rows, base, floors, hpp, log.lines, reps, default_isa, load_before);
+  std::vector<BlockTiming> blocks;
+  blocks.push_back(time_blocks<float, 3>(Scene::Elastic, n3, reps));
+  blocks.push_back(time_blocks<float, 3>(Scene::Fluid, n3, reps));
+  blocks.push_back(time_blocks<float, 2>(Scene::Elastic, n2, reps));
+  const std::string text = report(rows, base, floors, hpp, blocks, log.lines, reps, default_isa, load_before);
   std::fputs(text.c_str(), stdout);
   std::ofstream f(out);
   f << text;
