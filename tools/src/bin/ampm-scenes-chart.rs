@@ -90,6 +90,16 @@ fn colour(stepper: &str) -> RGBColor {
     }
 }
 
+/// `y` in plain decimals, as many as its leading digit needs (0.05, 0.2, 2, 40).
+fn decimal(y: f64) -> String {
+    let places = if y > 0.0 && y < 1.0 {
+        (-y.log10().floor()) as usize
+    } else {
+        0
+    };
+    format!("{y:.places$}")
+}
+
 fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     rows: &[Row],
@@ -129,7 +139,11 @@ where
             }
         })
         .y_desc(y_desc)
-        .y_label_formatter(&|y: &f64| format!("{y:.0e}"))
+        // A few decimal labels and one light line between them: a log axis over less than
+        // two decades otherwise gets a label and a line at every 1–9 × 10ᵏ, which run together.
+        .y_labels(6)
+        .y_max_light_lines(1)
+        .y_label_formatter(&|y: &f64| decimal(*y))
         .label_style((FONT, 13))
         .axis_desc_style((FONT, 13))
         .draw()?;
