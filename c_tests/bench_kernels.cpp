@@ -35,6 +35,7 @@
 #include <cstdint>
 
 #include "ampm.h"
+#include "bench_machine.hpp"
 #include "common.hpp"  // Rng (portable seeded draws), status names
 
 #include <Eigen/Dense>
@@ -575,10 +576,7 @@ struct Machine {
   bool have_flags = false, avx512f = false, avx2 = false, fma = false;
 };
 
-std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
-  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-}
+using bench_machine::trim;
 
 /// CPU model and ISA flags from the first processor of /proc/cpuinfo (Linux).
 Machine read_machine() {
@@ -608,19 +606,7 @@ Machine read_machine() {
   return m;
 }
 
-std::string compiler() {
-#if defined(__clang__)
-  std::string c = "clang " __clang_version__;
-#elif defined(__GNUC__)
-  std::string c = "g++ " __VERSION__;
-#else
-  std::string c = "unknown compiler";
-#endif
-#ifdef AMPM_BENCH_CXX_FLAGS
-  c += " (" AMPM_BENCH_CXX_FLAGS ")";
-#endif
-  return c;
-}
+using bench_machine::compiler;
 
 /// The ISA extensions this binary (the Eigen baseline and the memory floor) was compiled for.
 std::string compiled_for() {

@@ -77,7 +77,7 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
     check(k, "apply", cs.apply(&ff, fns[k].apply));
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
-  auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
+  auto ns = [&](auto t0, auto t1) { return ns_per(t0, t1, n); };
   // Results first: the same grids, particles and forces from both builds, bit for bit.
   std::vector<T> grid[2], parts[2], slots[2], df[2];
   std::vector<std::uint8_t> phase[2];
@@ -131,15 +131,11 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
     }
   }
   cs.restore();
-  auto median = [](std::vector<double>& v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   AbRow row;
   row.scene = scene_name(s), row.kase = Api<T, D>::name, row.isa = isa_name(isa);
   std::fprintf(stderr, "%-14s %s %-8s", row.scene.c_str(), row.kase.c_str(), row.isa.c_str());
   for (int c = 0; c < kAbN; ++c) {
-    for (int k = 0; k < 2; ++k) row.t[c][k] = median(times[c][k]);
+    for (int k = 0; k < 2; ++k) row.t[c][k] = median_of(times[c][k]);
     std::fprintf(stderr, "  %s %6.1f / %6.1f (%.3f)", kAbCalls[c], row.t[c][0], row.t[c][1], row.t[c][1] / row.t[c][0]);
   }
   std::fputc('\n', stderr);

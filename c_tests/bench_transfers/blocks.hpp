@@ -77,7 +77,7 @@ BlockTiming time_blocks(Scene s, int per_axis, int reps) {
   const std::size_t n = cs.p.n;
   auto blocks = [&](std::size_t b, const char* what, auto&& call) { in_blocks(cs, b, what, call); };
   auto clock = [] { return std::chrono::steady_clock::now(); };
-  auto ns = [&](auto t0, auto t1) { return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n); };
+  auto ns = [&](auto t0, auto t1) { return ns_per(t0, t1, n); };
   std::vector<double> lib[kNumBlocks], apply[kNumBlocks];
   for (int r = -1; r < reps; ++r)
     for (int j = 0; j < kNumBlocks; ++j) {
@@ -98,13 +98,9 @@ BlockTiming time_blocks(Scene s, int per_axis, int reps) {
       if (r >= 0) lib[j].push_back(ns(t0, t1) + ns(t2, t3)), apply[j].push_back(ns(t4, t5));
     }
   cs.restore();
-  auto median = [](std::vector<double>& v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
   BlockTiming bt;
   bt.scene = scene_name(s), bt.kase = Api<T, D>::name, bt.n = n;
-  for (int j = 0; j < kNumBlocks; ++j) bt.lib[j] = median(lib[j]), bt.apply[j] = median(apply[j]);
+  for (int j = 0; j < kNumBlocks; ++j) bt.lib[j] = median_of(lib[j]), bt.apply[j] = median_of(apply[j]);
   std::fprintf(stderr, "blocks %s %s: lib", bt.scene.c_str(), bt.kase.c_str());
   for (int j = 0; j < kNumBlocks; ++j) std::fprintf(stderr, " %zu:%.1f", kBlocks[j], bt.lib[j]);
   std::fprintf(stderr, ", apply");

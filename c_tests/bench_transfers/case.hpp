@@ -16,6 +16,19 @@ struct Timing {
   double median = NAN, min = NAN;
 };
 
+/// The median of `v` (sorted in place; the upper middle of an even count), as every timing here
+/// reports it.
+inline double median_of(std::vector<double>& v) {
+  std::sort(v.begin(), v.end());
+  return v[v.size() / 2];
+}
+
+/// The steady-clock interval `t0..t1` in ns per particle of `n`.
+inline double ns_per(std::chrono::steady_clock::time_point t0, std::chrono::steady_clock::time_point t1,
+                     std::size_t n) {
+  return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(n);
+}
+
 template <class Before, class Body>
 Timing time_ns(int reps, std::size_t n, Before&& before, Body&& body) {
   std::vector<double> ns;
@@ -26,8 +39,8 @@ Timing time_ns(int reps, std::size_t n, Before&& before, Body&& body) {
     const auto t1 = std::chrono::steady_clock::now();
     if (r >= 0) ns.push_back(std::chrono::duration<double, std::nano>(t1 - t0).count());
   }
-  std::sort(ns.begin(), ns.end());
-  return {ns[ns.size() / 2] / static_cast<double>(n), ns.front() / static_cast<double>(n)};
+  const double mid = median_of(ns);
+  return {mid / static_cast<double>(n), ns.front() / static_cast<double>(n)};
 }
 
 template <class Before, class Body>

@@ -6,7 +6,8 @@
 #include <cstdint>
 
 #include "ampm.h"
-#include "common.hpp"  // status_name, isa_name
+#include "bench_machine.hpp"  // cpu_model, compiler, load_average
+#include "common.hpp"         // status_name, isa_name
 
 #include <Eigen/Dense>
 
@@ -32,6 +33,9 @@ namespace bench {
 
 using ampm_test::isa_name;
 using ampm_test::status_name;
+using bench_machine::compiler;
+using bench_machine::cpu_model;
+using bench_machine::load_average;
 
 using ld = long double;
 

@@ -111,17 +111,16 @@ inline HppTiming time_hpp(int per_axis, int reps) {
     const auto t0 = std::chrono::steady_clock::now();
     body();
     const auto t1 = std::chrono::steady_clock::now();
-    return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(cs.p.n);
+    return ns_per(t0, t1, cs.p.n);
   };
   for (int r = -1; r < reps; ++r) {
     const double a = once([&] { c_step(cs); });
     const double b = once([&] { hs.step(); });
     if (r >= 0) tc.push_back(a), th.push_back(b);
   }
-  std::sort(tc.begin(), tc.end());
-  std::sort(th.begin(), th.end());
+  const double c = median_of(tc), hpp = median_of(th);  // both sorted: front() is the fastest
   cs.restore();
-  return {cs.p.n, tc[tc.size() / 2], th[th.size() / 2], tc.front(), th.front()};
+  return {cs.p.n, c, hpp, tc.front(), th.front()};
 }
 
 }  // namespace bench

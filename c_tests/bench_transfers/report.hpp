@@ -1,5 +1,5 @@
-// The machine's description and the markdown report: the cost table, the targets, the Eigen
-// baseline, the hardware floor, the wrapper and the block calls; and the timing of every case.
+// The markdown report (the cost table, the targets, the Eigen baseline, the hardware floor,
+// the wrapper and the block calls) and the timing of every case.
 #pragma once
 
 #include <fstream>
@@ -13,46 +13,6 @@
 #include "hpp_step.hpp"
 
 namespace bench {
-
-// ---- machine and report --------------------------------------------------------------------
-
-inline std::string trim(const std::string& s) {
-  const auto b = s.find_first_not_of(" \t"), e = s.find_last_not_of(" \t");
-  return b == std::string::npos ? std::string() : s.substr(b, e - b + 1);
-}
-
-inline std::string cpu_model() {
-  std::ifstream in("/proc/cpuinfo");
-  std::string line;
-  while (std::getline(in, line)) {
-    const auto colon = line.find(':');
-    if (colon != std::string::npos && trim(line.substr(0, colon)) == "model name") return trim(line.substr(colon + 1));
-  }
-  return "unknown CPU";
-}
-
-/// /proc/loadavg's 1-minute load average (other processes compete for the cores when it is
-/// near or above the core count), or "unknown".
-inline std::string load_average() {
-  std::ifstream in("/proc/loadavg");
-  std::string l;
-  return in >> l ? l : std::string("unknown");
-}
-
-inline std::string compiler() {
-#if defined(__clang__)
-  std::string c = "clang " __clang_version__;
-#elif defined(__GNUC__)
-  std::string c = "g++ " __VERSION__;
-#else
-  std::string c = "unknown compiler";
-#endif
-#ifdef AMPM_BENCH_CXX_FLAGS
-  c += " (" AMPM_BENCH_CXX_FLAGS ")";
-#endif
-  return c;
-}
-
 
 inline std::string fmt(double ns) {
   if (std::isnan(ns)) return "n/a";
@@ -247,7 +207,7 @@ inline Baseline time_baseline(int per_axis, int reps) {
     const auto t0 = std::chrono::steady_clock::now();
     body();
     const auto t1 = std::chrono::steady_clock::now();
-    return std::chrono::duration<double, std::nano>(t1 - t0).count() / static_cast<double>(cs.p.n);
+    return ns_per(t0, t1, cs.p.n);
   };
   std::vector<double> ep, eg, lp, lg;
   auto zero = [&] { cs.g.zero_p2g(); };
@@ -263,11 +223,7 @@ inline Baseline time_baseline(int per_axis, int reps) {
     if (r >= 0) lp.push_back(a), ep.push_back(b2), lg.push_back(c), eg.push_back(d);
   }
   cs.restore();
-  auto median = [](std::vector<double>& v) {
-    std::sort(v.begin(), v.end());
-    return v[v.size() / 2];
-  };
-  b.p2g = median(ep), b.g2p = median(eg), b.lib_p2g = median(lp), b.lib_g2p = median(lg);
+  b.p2g = median_of(ep), b.g2p = median_of(eg), b.lib_p2g = median_of(lp), b.lib_g2p = median_of(lg);
   return b;
 }
 
