@@ -116,43 +116,34 @@ struct Case {
     std::copy(p0.u.begin(), p0.u.end(), p.u.begin());
     std::copy(p0.ph.begin(), p0.ph.end(), p.ph.begin());
   }
-  // Each call through `f`: this binary's symbol by default, another build's with --ab.
-  AmpmStatus p2g_sym(std::size_t* ff, decltype(A::p2g) f = A::p2g) {
+  // The calls over particles [i, i + k) (the whole batch by default, or a host's block of
+  // particles, with `ff` relative to i), through `f`: this binary's symbol by default, another
+  // build's with --ab.
+  AmpmStatus p2g_sym(std::size_t* ff, decltype(A::p2g) f = A::p2g) { return p2g_sym_range(0, p.n, ff, f); }
+  AmpmStatus p2g_sym_range(std::size_t i, std::size_t k, std::size_t* ff, decltype(A::p2g) f = A::p2g) {
     const auto m = material<T, D>(scene, false);
-    auto pv = p.view();
-    return f(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, p.n, &pv, &v.sym, ff);
+    auto pv = p.view_at(i);
+    return f(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, k, &pv, &v.sym, ff);
   }
   AmpmStatus p2g_f(std::size_t* ff) {
     const auto m = material<T, D>(scene, false);
     auto pv = p.view();
     return A::p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, T(0), p.n, &pv, &v.plus_f, ff);
   }
-  AmpmStatus g2p(std::size_t* ff, decltype(A::g2p) f = A::g2p) {
+  AmpmStatus g2p(std::size_t* ff, decltype(A::g2p) f = A::g2p) { return g2p_range(0, p.n, ff, f); }
+  AmpmStatus g2p_range(std::size_t i, std::size_t k, std::size_t* ff, decltype(A::g2p) f = A::g2p) {
     const auto m = material<T, D>(scene, false);
-    auto pv = p.view();
-    return f(&m, AMPM_KERNEL_QUADRATIC, h, dt, p.n, &pv, &v.g2p, ff);
+    auto pv = p.view_at(i);
+    return f(&m, AMPM_KERNEL_QUADRATIC, h, dt, k, &pv, &v.g2p, ff);
   }
   AmpmStatus prepare(std::size_t* ff, decltype(A::prepare) f = A::prepare) {
     const auto m = material<T, D>(scene, true);
     auto pv = p.view();
     return f(&m, p.n, &pv, slots.data(), ff);
   }
-  AmpmStatus apply(std::size_t* ff, decltype(A::apply) f = A::apply) {
-    return f(AMPM_KERNEL_QUADRATIC, h, p.n, p.x.data(), slots.data(), &v.force, ff);
-  }
-  // The same calls over particles [i, i + k) (a host's block of particles), with `ff` relative to i.
-  AmpmStatus p2g_sym_range(std::size_t i, std::size_t k, std::size_t* ff) {
-    const auto m = material<T, D>(scene, false);
-    auto pv = p.view_at(i);
-    return A::p2g(&m, AMPM_KERNEL_QUADRATIC, AMPM_GRID_COLLOCATED, h, dt, k, &pv, &v.sym, ff);
-  }
-  AmpmStatus g2p_range(std::size_t i, std::size_t k, std::size_t* ff) {
-    const auto m = material<T, D>(scene, false);
-    auto pv = p.view_at(i);
-    return A::g2p(&m, AMPM_KERNEL_QUADRATIC, h, dt, k, &pv, &v.g2p, ff);
-  }
-  AmpmStatus apply_range(std::size_t i, std::size_t k, std::size_t* ff) {
-    return A::apply(AMPM_KERNEL_QUADRATIC, h, k, p.x.data() + i * D, slots.data() + i * A::slot_len, &v.force, ff);
+  AmpmStatus apply(std::size_t* ff, decltype(A::apply) f = A::apply) { return apply_range(0, p.n, ff, f); }
+  AmpmStatus apply_range(std::size_t i, std::size_t k, std::size_t* ff, decltype(A::apply) f = A::apply) {
+    return f(AMPM_KERNEL_QUADRATIC, h, k, p.x.data() + i * D, slots.data() + i * A::slot_len, &v.force, ff);
   }
   void zero_df() {
     for (int a = 0; a < D; ++a) std::fill(g.df[a].begin(), g.df[a].end(), T(0));
