@@ -151,8 +151,9 @@ where
 }
 
 /// G2P of a whole batch gives the bits of calls of one particle each, on every instruction set
-/// and material, for solid and for liquid batches: the batch updates chunks of elastic solids
-/// and of liquids on SIMD lanes, a call of one particle updates it alone (the scalar update).
+/// and material, for solid and for liquid batches: the batch updates chunks of solids (elastic,
+/// and snow with its SVD) and of liquids on SIMD lanes, a call of one particle updates it alone
+/// (the scalar update, with the snow step on the lanes of the same row type).
 /// The batch mixes chunks that stay on lanes (one with a particle of the other phase among
 /// them) with chunks that must fall back: a particle with a NaN `F_P`, one whose `F_E` is
 /// inverted, one needing the remedy for `det(I + Δt∇v) ≤ 0` (a strongly compressive node

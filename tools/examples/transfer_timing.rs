@@ -1,6 +1,6 @@
 //! Quick split timing of P2G, G2P and the force differential's apply (f32 quadratic, 3D, or 2D
 //! with `AMPM_TT_DIM=2`): `cargo run --release -p ampm-tools --example transfer_timing --
-//! <fluid|elastic|thermal>` (a development aid; the benchmarks are `c_tests/bench_transfers`
+//! <fluid|elastic|thermal|snow>` (a development aid; the benchmarks are `c_tests/bench_transfers`
 //! and `tools/benches/particle_levels.rs`). Environment: `AMPM_TT_REPS` (runs, best kept),
 //! `AMPM_TT_ISA` (`avx2`, `avx512`, ...: that instruction set only), `AMPM_TT_SIDE` (particles
 //! per axis), `AMPM_TT_PAD` (more grid nodes per axis), `AMPM_TT_JOINED` (`0` or `1`: AVX-512
@@ -11,7 +11,7 @@ use ampm_core::particle::transfer::force::{self, ForceView};
 use ampm_core::particle::transfer::g2p::{self, G2pArgs, G2pView};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
 use ampm_core::particle::transfer::{Channel, NodeBox, Particles};
-use ampm_core::particle::{Grid, Heat, Kernel, Material, Phase, PhaseParams};
+use ampm_core::particle::{Grid, Heat, Kernel, Material, Phase, PhaseParams, Snow};
 
 /// CPU time of this thread (s): unlike wall time, it does not count the time other
 /// processes on a shared machine hold the core.
@@ -64,6 +64,8 @@ where
     // `thermal`: the elastic level with heat and phase change (solids at 270 K, melting at
     // 273.15 K).
     let thermal = level == "thermal";
+    // `snow`: the elastic level with snow plasticity (the benchmark's parameters).
+    let snow = level == "snow";
     // 54,872 particles in 3D, 262,144 in 2D.
     // `AMPM_TT_SIDE`: particles per axis instead (a small side keeps the particles and the
     // grid in the cache).
@@ -142,6 +144,11 @@ where
             melting_point: 273.15,
             latent_heat: 3.34e5,
             phase_change: true,
+        }),
+        plasticity: snow.then_some(Snow {
+            critical_compression: 2.5e-2,
+            critical_stretch: 7.5e-3,
+            hardening: 10.0,
         }),
         ..Material::default()
     };

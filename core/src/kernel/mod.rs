@@ -33,8 +33,7 @@ use crate::lane::lmat::{
     mul_nt, mul_tn, pow2_factors, recip, scale_pow2, LMat,
 };
 use crate::lane::Lane;
-use crate::polar::lanes::{scaled_input, LSvd};
-use crate::polar::{closed_form_2d, one_sided_jacobi, OneSidedJacobi};
+use crate::polar::lanes::{default_svd, scaled_input, LSvd};
 use crate::scalar::Real;
 
 /// The index pairs `i < j` of the SVD basis, in storage order (2D uses the first).
@@ -49,7 +48,7 @@ pub const fn pairs(d: usize) -> usize {
 
 /// The default decomposition of each dimension, on lanes.
 pub trait LaneDim<const D: usize> {
-    /// The rotation-variant SVD of a scaled `G` ([`closed_form_2d`] or [`one_sided_jacobi`]
+    /// The rotation-variant SVD of a scaled `G` ([`default_svd`]: closed form or one-sided Jacobi
     /// with the precision's default sweeps).
     fn svd<V: Lane>(g: &LMat<V, D>) -> LSvd<V, D>;
     /// Sweeps of the symmetric eigen-solve of the scaling block ([`psd_block`]).
@@ -63,7 +62,7 @@ pub struct Dim<const D: usize>;
 impl LaneDim<2> for Dim<2> {
     #[inline(always)]
     fn svd<V: Lane>(g: &LMat<V, 2>) -> LSvd<V, 2> {
-        closed_form_2d(g)
+        default_svd(g)
     }
     #[inline(always)]
     fn eigen_sweeps<T: Real>() -> u32 {
@@ -76,7 +75,7 @@ impl LaneDim<2> for Dim<2> {
 impl LaneDim<3> for Dim<3> {
     #[inline(always)]
     fn svd<V: Lane>(g: &LMat<V, 3>) -> LSvd<V, 3> {
-        one_sided_jacobi(g, OneSidedJacobi::sweeps_for(V::Scalar::MANTISSA_DIGITS))
+        default_svd(g)
     }
     #[inline(always)]
     fn eigen_sweeps<T: Real>() -> u32 {

@@ -13,7 +13,9 @@
 //! - Snow plasticity (Stomakhin et al. 2013, §4): `F_E = U Σ Vᵀ`, `Σ̂ = clamp(Σ, 1 − θ_c,
 //!   1 + θ_s)`, `F_E ← U Σ̂ Vᵀ`, `F_P ← F_E⁻¹ F = V Σ̂⁻¹ Σ Vᵀ F_P` (no inverse is formed).
 //!   This keeps `F = F_E F_P` (up to rounding) and moves `det Σ / det Σ̂` from `J_E` to
-//!   `J_P`, so `J = J_E J_P` is kept.
+//!   `J_P`, so `J = J_E J_P` is kept. The SVD is the default decomposition on lanes (closed
+//!   form in 2D, one-sided Jacobi in 3D, [`crate::polar::lanes::default_svd`]), and the step is
+//!   written once over lanes (`snow_lanes`): G2P's batch runs it on SIMD lanes.
 //! - Liquid (Stomakhin et al. 2014, §4): the paper resets a fluid's `F_E` to `J_E^{1/d} I`
 //!   after each update, so that `μ = 0` leaves only `Ψ_λ(J_E)`. What a liquid particle is
 //!   ever asked for then depends on two numbers: the stress `λ(J_E − 1) J_E I` and the
@@ -44,8 +46,10 @@
 //! [`Error::NonPositiveJ`]. See [`check_det`].
 
 use crate::error::{Error, Result};
+use crate::lane::lmat::{self, mul_diag_nt, LMat};
+use crate::lane::Lane;
 use crate::mat::{Mat, Matrix};
-use crate::polar::{DefaultSvd, SvdMethod};
+use crate::polar::lanes::{default_svd, scaled_input};
 use crate::scalar::Real;
 
 use super::Snow;
@@ -147,10 +151,12 @@ where
 
 /// Snow plasticity: returns `(F_E, F_P)` after clamping the singular values of `f_e` to
 /// `[1 − θ_c, 1 + θ_s]` (see the module docs); when no singular value is clamped, `f_e` and
-/// `f_p` unchanged. Requires `det f_e > 0`.
+/// `f_p` unchanged. Requires `det f_e > 0`. The step is that of G2P's batch on SIMD lanes
+/// (`snow_lanes`), here on one scalar.
 ///
-/// Errors: those of the SVD; [`Error::NonPositiveJ`] for `det f_e ≤ 0`; those of
-/// [`check_det`] for the new `F_E` and `F_P`.
+/// Errors: [`Error::NonFinite`] for a non-finite `f_e`; [`Error::NonPositiveJ`] for a
+/// non-positive singular value (`det f_e ≤ 0`); those of [`check_det`] for the new `F_E` and
+/// `F_P`.
 #[inline]
 pub fn snow_plasticity<T: Real, const D: usize>(
     snow: &Snow<T>,
@@ -159,36 +165,117 @@ pub fn snow_plasticity<T: Real, const D: usize>(
 ) -> Result<(Mat<T, D>, Mat<T, D>)>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
-    DefaultSvd: SvdMethod<Mat<T, D>>,
 {
-    let svd = DefaultSvd.svd(f_e)?;
-    let lo = T::ONE - snow.critical_compression;
-    let hi = T::ONE + snow.critical_stretch;
-    let mut clamped = svd.sigma;
-    let mut ratio = [T::ONE; D];
-    for i in 0..D {
-        let s = svd.sigma[i];
-        if s <= T::ZERO {
-            // Rotation-variant SVD: only det F_E ≤ 0 gives a non-positive σ.
-            return Err(Error::NonPositiveJ);
-        }
-        clamped[i] = s.max(lo).min(hi);
-        ratio[i] = s / clamped[i];
+    snow_plasticity_on::<T, T, D>(snow, f_e, f_p)
+}
+
+/// [`snow_plasticity`] with the step evaluated on lanes of `V` (the particle in every lane,
+/// lane 0 kept): the bits that every lane of a chunk of `V` gets from [`snow_lanes`]. G2P's
+/// batch takes the step on its row type for a particle updated on its own too, so that a
+/// particle's result does not depend on whether its chunk ran on lanes.
+#[inline(always)]
+pub(crate) fn snow_plasticity_on<T: Real, V: Lane<Scalar = T>, const D: usize>(
+    snow: &Snow<T>,
+    f_e: &Mat<T, D>,
+    f_p: &Mat<T, D>,
+) -> Result<(Mat<T, D>, Mat<T, D>)>
+where
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    if !f_e.is_finite() {
+        return Err(Error::NonFinite);
     }
-    if ratio.iter().all(|&r| r == T::ONE) {
-        // Nothing clamped (`σ/σ = 1` exactly): the step is the identity, so keep the inputs
-        // bit for bit rather than rounding them through `U Σ Vᵀ` and `V Vᵀ F_P`.
-        check_det(f_e)?;
-        check_det(f_p)?;
-        return Ok((*f_e, *f_p));
+    let splat = |m: &Mat<T, D>| m.cols.map(|c| c.map(V::splat));
+    let out = snow_lanes(snow_bounds(snow).map(V::splat), &splat(f_e), &splat(f_p));
+    if V::mask_bits(out.positive) & 1 == 0 {
+        return Err(Error::NonPositiveJ);
     }
-    let fe = svd.u * Mat::from_diagonal(clamped) * svd.v.transpose();
-    let fp = svd.v * Mat::from_diagonal(ratio) * svd.v.transpose() * *f_p;
+    let lane0 = |m: &LMat<V, D>| {
+        Mat::from_cols(m.map(|c| {
+            c.map(|x| {
+                let mut y = T::ZERO;
+                // SAFETY: one scalar written to `y`.
+                unsafe { x.store_n(&mut y, 1) };
+                y
+            })
+        }))
+    };
+    let (fe, fp) = (lane0(&out.f_e), lane0(&out.f_p));
     // V diag(σ/σ̂) Vᵀ has condition max(σ/σ̂)/min(σ/σ̂): for an `F_E` stretched beyond ~1/ε
     // the new `F_P` is singular to working precision, and a tiny `J_P` may underflow.
     check_det(&fe)?;
     check_det(&fp)?;
     Ok((fe, fp))
+}
+
+/// The clamp bounds `[1 − θ_c, 1 + θ_s]` of snow plasticity.
+#[inline(always)]
+#[must_use]
+pub(crate) fn snow_bounds<T: Real>(snow: &Snow<T>) -> [T; 2] {
+    [
+        T::ONE - snow.critical_compression,
+        T::ONE + snow.critical_stretch,
+    ]
+}
+
+/// The snow step of every lane ([`snow_lanes`]).
+#[derive(Clone, Copy)]
+pub(crate) struct SnowLanes<V: Lane, const D: usize> {
+    /// The new `F_E`: `U Σ̂ Vᵀ`, or the input where nothing is clamped.
+    pub f_e: LMat<V, D>,
+    /// The new `F_P`: `(V diag(σ/σ̂) Vᵀ) F_P`, or the input where nothing is clamped.
+    pub f_p: LMat<V, D>,
+    /// The lanes whose singular values are all positive (`det F_E > 0`); the others' results
+    /// are meaningless.
+    pub positive: V::Mask,
+}
+
+/// Snow plasticity per lane (Stomakhin et al. 2013, §4; see the module docs) of a finite
+/// `f_e` with clamp bounds `[lo, hi]` ([`snow_bounds`]): the rotation-variant SVD
+/// `F_E = U Σ Vᵀ` of the default decomposition on lanes ([`default_svd`], on the
+/// power-of-two-scaled input), `σ̂ = min(max(σ, lo), hi)`, `F_E ← U diag(σ̂) Vᵀ` and
+/// `F_P ← (V diag(σ/σ̂) Vᵀ) F_P`. A lane where every `σ/σ̂` is exactly 1 keeps its inputs bit for
+/// bit (the step is the identity; rounding it through the products would move them). The
+/// one source of the scalar [`snow_plasticity`] (on a lane pair) and of G2P's update on lanes.
+///
+/// [`default_svd`]: crate::polar::lanes::default_svd
+#[inline(always)]
+#[must_use]
+pub(crate) fn snow_lanes<V: Lane, const D: usize>(
+    [lo, hi]: [V; 2],
+    f_e: &LMat<V, D>,
+    f_p: &LMat<V, D>,
+) -> SnowLanes<V, D> {
+    let (g, k) = scaled_input(f_e);
+    let svd = default_svd(&g).unscaled(k);
+    let (zero, one) = (V::splat(V::Scalar::ZERO), V::splat(V::Scalar::ONE));
+    let mut positive = zero.le(zero);
+    let mut same = positive;
+    let mut clamped = svd.sigma;
+    let mut ratio = [one; D];
+    for i in 0..D {
+        let s = svd.sigma[i];
+        positive = positive & zero.lt(s);
+        clamped[i] = s.max(lo).min(hi);
+        ratio[i] = s / clamped[i];
+        same = same & ratio[i].eq(one);
+    }
+    let fe = mul_diag_nt(&svd.u, &clamped, &svd.v);
+    let fp = lmat::mul(&mul_diag_nt(&svd.v, &ratio, &svd.v), f_p);
+    let keep = |a: &LMat<V, D>, b: &LMat<V, D>| {
+        let mut r = *b;
+        for (cr, ca) in r.iter_mut().zip(a) {
+            for (x, y) in cr.iter_mut().zip(ca) {
+                *x = V::select(same, *y, *x);
+            }
+        }
+        r
+    };
+    SnowLanes {
+        f_e: keep(f_e, &fe),
+        f_p: keep(f_p, &fp),
+        positive,
+    }
 }
 
 /// `J^{1/d}` by `sqrt` (d = 2) or `cbrt` (d = 3).

@@ -28,11 +28,12 @@
 //! [`apic::gather`]: super::apic::gather
 
 use super::apic::gather;
-use super::deformation::{advance, check_det, increment, liquid_step, snow_plasticity};
+use super::deformation::{advance, check_det, increment, liquid_step, snow_plasticity_on};
 use super::stencil::{Grid, Kernel, Stencil};
 use super::thermal::{self, HeatSplit, ThermalState};
 use super::{Material, Particle, Phase};
 use crate::error::{Error, Result};
+use crate::lane::Lane;
 use crate::mat::{Mat, Matrix};
 use crate::polar::{DefaultSvd, SvdMethod};
 use crate::scalar::Real;
@@ -163,8 +164,8 @@ fn check_temperature<T: Real, const D: usize>(
 /// 3. `F_E ← (I + Δt∇v) F_E` with the remedy ([`evolve`](super::deformation::evolve));
 /// 4. a liquid keeps its volume ratios only ([`liquid_step`]: `F_E ← J_E^{1/d} I`,
 ///    `F_P ← J_P^{1/d} I`, for an isotropic `F_E` from `det(I + Δt∇v)` without the product
-///    of step 3); a solid with snow plasticity clamps ([`snow_plasticity`]); an
-///    elastic solid does neither.
+///    of step 3); a solid with snow plasticity clamps ([`snow_plasticity`]); an elastic solid
+///    does neither.
 ///
 /// The phase of step 4 is the one after step 1 (a solid that melts is projected at once).
 /// The new particle is checked as the next call will check it ([`check_particle`],
@@ -180,6 +181,8 @@ fn check_temperature<T: Real, const D: usize>(
 /// determinants, or the hardening factor of the new `J_P`); [`Error::NonPositiveJ`] for a new
 /// `F_E` or `F_P` singular to working precision (e.g. the plastic flow of an `F_E` stretched
 /// beyond `~1/ε`); the kernels' errors.
+///
+/// [`snow_plasticity`]: super::deformation::snow_plasticity
 #[inline]
 pub fn update_particle<T: Real, const D: usize>(
     material: &Material<T>,
@@ -193,14 +196,18 @@ where
 {
     let j_p = check_update_inputs(material, dt, p)?;
     check_temperature(material, p)?;
-    update_checked(material, dt, s, p, j_p)
+    update_checked::<T, T, D>(material, dt, s, p, j_p)
 }
 
 /// [`update_particle`] for a caller that has validated the material for the particle's phase
 /// (`material.validate(p.phase)`, as the batch transfers do once per call): the particle,
-/// `dt` and temperature checks and the update, inlined into the caller's loop.
+/// `dt` and temperature checks and the update, inlined into the caller's loop. Snow
+/// plasticity's step runs on lanes of `V` ([`snow_plasticity_on`]: the bits of the batch's
+/// chunks of `V`).
+///
+/// [`snow_plasticity_on`]: super::deformation::snow_plasticity_on
 #[inline(always)]
-pub(crate) fn update_validated<T: Real, const D: usize>(
+pub(crate) fn update_validated<T: Real, V: Lane<Scalar = T>, const D: usize>(
     material: &Material<T>,
     dt: T,
     s: &G2pSample<T, D>,
@@ -212,13 +219,13 @@ where
 {
     let j_p = check_particle_dt(p, dt)?;
     check_temperature(material, p)?;
-    update_checked(material, dt, s, p, j_p)
+    update_checked::<T, V, D>(material, dt, s, p, j_p)
 }
 
 /// [`update_particle`] after its input checks ([`check_update_inputs`], the temperature), which
-/// gave `j_p = det F_P`.
+/// gave `j_p = det F_P`; snow plasticity's step on lanes of `V`.
 #[inline(always)]
-fn update_checked<T: Real, const D: usize>(
+fn update_checked<T: Real, V: Lane<Scalar = T>, const D: usize>(
     material: &Material<T>,
     dt: T,
     s: &G2pSample<T, D>,
@@ -273,7 +280,7 @@ where
             let (f_e, j_e) = advance(&a, &p.f_e)?;
             match plasticity {
                 Some(snow) => {
-                    let (fe, fp) = snow_plasticity(snow, &f_e, &p.f_p)?;
+                    let (fe, fp) = snow_plasticity_on::<T, V, D>(snow, &f_e, &p.f_p)?;
                     (fe, fp, None)
                 }
                 None => (f_e, p.f_p, Some((j_e, j_p))),
@@ -377,7 +384,7 @@ where
         t_pic,
         t_flip,
     };
-    let (out, info) = update_checked(material, dt, &sample, p, j_p)?;
+    let (out, info) = update_checked::<T, T, D>(material, dt, &sample, p, j_p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, h, &out.x).is_err() {
         // The cell index of the new position is beyond the supported range.
         return Err(Error::Overflow);

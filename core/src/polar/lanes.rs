@@ -45,6 +45,46 @@ where
     }
 }
 
+/// The default decomposition of a scaled `G` (finite, largest entry in `[0.5, 1)`, or 0) on
+/// lanes, for either dimension: [`closed_form_2d`] in 2D, [`one_sided_jacobi`] with the
+/// precision's sweeps ([`OneSidedJacobi::sweeps_for`]) in 3D. On vectors and on `X2` lane pairs
+/// of scalars it runs branch-free, so each lane's bits are the same on every path.
+///
+/// [`closed_form_2d`]: super::closed_form_2d
+/// [`one_sided_jacobi`]: super::one_sided_jacobi
+/// [`OneSidedJacobi::sweeps_for`]: super::OneSidedJacobi::sweeps_for
+#[inline(always)]
+#[must_use]
+pub fn default_svd<V: Lane, const D: usize>(g: &LMat<V, D>) -> LSvd<V, D> {
+    if D == 2 {
+        super::closed_form_2d(&resized::<V, D, 2>(g)).resized()
+    } else {
+        let sweeps = super::OneSidedJacobi::sweeps_for(V::Scalar::MANTISSA_DIGITS);
+        super::one_sided_jacobi(&resized::<V, D, 3>(g), sweeps).resized()
+    }
+}
+
+/// `m` as a matrix of size `B` (called where `A = B`: the generic dimension as the concrete
+/// one of a decomposition, and back).
+#[inline(always)]
+fn resized<V: Copy, const A: usize, const B: usize>(m: &[[V; A]; A]) -> [[V; B]; B] {
+    debug_assert_eq!(A, B);
+    core::array::from_fn(|j| core::array::from_fn(|i| m[j][i]))
+}
+
+impl<V: Lane, const A: usize> LSvd<V, A> {
+    /// The same decomposition typed with size `B` (`A = B`).
+    #[inline(always)]
+    fn resized<const B: usize>(&self) -> LSvd<V, B> {
+        debug_assert_eq!(A, B);
+        LSvd {
+            u: resized(&self.u),
+            sigma: core::array::from_fn(|i| self.sigma[i]),
+            v: resized(&self.v),
+        }
+    }
+}
+
 /// `(G, k)` with `F = 2ᵏ G` and `G`'s largest entry in `[0.5, 1)` (exact; `k = 0`, `G = 0`
 /// for `F = 0`). `F` must be finite.
 #[inline(always)]

@@ -267,7 +267,7 @@ where
             for (k, (smp, st)) in samples.iter().zip(&status).enumerate().take(len) {
                 // SAFETY: as above.
                 let r = unsafe {
-                    update_one(
+                    update_one::<T, R, D>(
                         self.material,
                         &self.checked,
                         self.args,
@@ -288,9 +288,10 @@ where
 const CHUNK: usize = update_lanes::LANES;
 
 /// The update of particle `i` from its grid sample (or the sample's error): the particle's
-/// checks, then the sample's status, then [`update_validated`] and the position limit.
+/// checks, then the sample's status, then [`update_validated`] (snow plasticity's step on
+/// lanes of the chunk's row type `R`, as the chunks on lanes take it) and the position limit.
 #[inline(always)]
-unsafe fn update_one<T: Real, const D: usize>(
+unsafe fn update_one<T: Real, R: Lane<Scalar = T>, const D: usize>(
     material: &Material<T>,
     checked: &Checked,
     args: &G2pArgs<T>,
@@ -307,7 +308,7 @@ where
     checked.for_phase(p.phase)?;
     let sample = sample?;
     // The material was validated for this phase above (`checked`).
-    let (out, _) = update_validated(material, args.dt, sample, &p)?;
+    let (out, _) = update_validated::<T, R, D>(material, args.dt, sample, &p)?;
     if Stencil::<T, D>::check_position(Grid::Collocated, args.h, &out.x).is_err() {
         // The cell index of the new position is beyond the supported range (as g2p_update).
         return Err(Error::Overflow);

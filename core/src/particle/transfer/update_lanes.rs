@@ -1,14 +1,17 @@
-//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane), when
-//! every particle of the chunk is, after its heat step, either a solid without plasticity (the
-//! plain elastic update) or a liquid (solids and liquids may share a chunk).
+//! G2P's particle update for a chunk of particles on SIMD lanes (one particle per lane): solids,
+//! with or without snow plasticity, and liquids (solids and liquids may share a chunk).
 //!
 //! The update is that of [`crate::particle::update::update_particle`] for these particles
 //! (Stomakhin et al. 2014, §5: APIC velocity and affine matrix, `x ← x + Δt v`,
-//! `F_E ← (I + Δt∇v) F_E`; a solid keeps `F_P`, a liquid's isotropic `F_E` takes the root of
-//! `det(I + Δt∇v)` and its `F_P` is projected to its volume ratio by [`liquid_step`]), with the
-//! same operations in the same order (separate multiplications and additions, no fused
-//! multiply-add, the matrix products and determinants of [`crate::mat::Mat`], the power-of-two
-//! scalings and roots of [`root_det`]), so every lane gets the bits of the scalar update. With
+//! `F_E ← (I + Δt∇v) F_E`; an elastic solid keeps `F_P`, a snow solid clamps both by
+//! [`snow_lanes`], a liquid's isotropic `F_E` takes the root of `det(I + Δt∇v)` and its `F_P` is
+//! projected to its volume ratio by [`liquid_step`]), with the same operations in the same order
+//! (separate multiplications and additions, no fused multiply-add, the matrix products and
+//! determinants of [`crate::mat::Mat`], the power-of-two scalings and roots of [`root_det`]), so
+//! every lane gets the bits of the scalar update. The snow step is written once, on lanes (with
+//! the fused multiply-adds and Newton roots of the lane type): G2P's batch takes it on lanes of
+//! its row type for a particle updated on its own too ([`snow_plasticity_on`], the particle in
+//! every lane), so both paths give the same bits. With
 //! heat, the heat step (temperature, latent buffer, phase) is made on the lanes when every lane
 //! stays in its segment of the latent-heat model, else by the scalar [`thermal::step`] per lane
 //! ([`heat`]). Every check of the scalar path is made on all lanes (the input particle as
@@ -23,15 +26,18 @@
 //! [`thermal::step`]: crate::particle::thermal::step
 //! [`liquid_step`]: crate::particle::deformation::liquid_step
 //! [`root_det`]: crate::particle::deformation::root_det
+//! [`snow_lanes`]: crate::particle::deformation::snow_lanes
+//! [`snow_plasticity_on`]: crate::particle::deformation::snow_plasticity_on
 
 mod heat;
 
 use super::{rd, wr, Checked, Particles};
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
+use crate::particle::deformation::{snow_bounds, snow_lanes};
 use crate::particle::thermal::ThermalState;
 use crate::particle::update::G2pSample;
-use crate::particle::{Material, Phase};
+use crate::particle::{Material, Phase, Snow};
 use crate::scalar::Real;
 
 /// Particles per chunk: the eight lanes of the row types.
@@ -236,6 +242,39 @@ fn root_det<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> (V,
     (r, ok & r.is_finite() & zero.lt(r))
 }
 
+/// Snow plasticity of a chunk's solids ([`snow_lanes`], the bits of [`snow_plasticity_on`]
+/// with this lane type) from their `A F_E` (`f`) and `F_P`: the new `(F_E, F_P)` and the lanes
+/// where the scalar update accepts them: positive singular values, both results passing
+/// [`check_det`], and the hardened moduli at the new `J_P` finite ([`Material::moduli`], which
+/// the next entry checks; by one scalar call per solid lane). Liquid lanes (`liquid_flags`
+/// nonzero) are not checked.
+///
+/// [`snow_plasticity_on`]: crate::particle::deformation::snow_plasticity_on
+/// [`check_det`]: crate::particle::deformation::check_det
+#[inline(always)]
+fn snow<T: Real, V: Lane<Scalar = T>, const D: usize>(
+    material: &Material<T>,
+    sn: &Snow<T>,
+    f: &LMat<V, D>,
+    f_p: &LMat<V, D>,
+    liquid_flags: &[T; LANES],
+) -> (LMat<V, D>, LMat<V, D>, V::Mask) {
+    let out = snow_lanes(snow_bounds(sn).map(V::splat), f, f_p);
+    let mut ok = out.positive & det_ok(&out.f_e) & det_ok(&out.f_p);
+    if sn.hardening != T::ZERO {
+        let mut j_p = [T::ZERO; LANES];
+        lmat::det(&out.f_p).store(&mut j_p);
+        let mut hard = [T::ZERO; LANES];
+        for ((h, &j), &fl) in hard.iter_mut().zip(&j_p).zip(liquid_flags) {
+            if fl == T::ZERO && material.moduli(Phase::Solid, j).is_ok() {
+                *h = T::ONE;
+            }
+        }
+        ok = ok & V::splat(T::ZERO).lt(V::load(&hard));
+    }
+    (out.f_e, out.f_p, ok)
+}
+
 /// `a` on the lanes of `m`, `b` on the others.
 #[inline(always)]
 fn select_mat<V: Lane, const D: usize>(m: V::Mask, a: &LMat<V, D>, b: &LMat<V, D>) -> LMat<V, D> {
@@ -325,11 +364,10 @@ fn isotropic_mask<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) 
 }
 
 /// Updates particles `start..start + LANES` from their transposed samples `cs` (each sample
-/// was computed without error) with step `dt` on a collocated grid of spacing `h`, if the chunk
-/// holds only solids (material without plasticity) and liquids after the heat step and every
+/// was computed without error) with step `dt` on a collocated grid of spacing `h`, if every
 /// lane passes every check of the scalar update (see the module docs); returns whether it did.
-/// Writes `x, v, affine, f_e`, `f_p` where a liquid's changes, and with heat the temperature
-/// (with phase change also the latent buffer and the phase).
+/// Writes `x, v, affine, f_e`, `f_p` where a liquid's or a snow solid's changes, and with heat
+/// the temperature (with phase change also the latent buffer and the phase).
 ///
 /// # Safety
 /// The arrays of `ps` that the update reads and writes hold the chunk's particles.
@@ -374,13 +412,10 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
             heat_new.map(|st| st.phase)
         }
     };
-    // Liquid lanes, and solids only without plasticity.
     let mut liquid_flags = [T::ZERO; LANES];
     for (fl, p) in liquid_flags.iter_mut().zip(&phases) {
-        match p {
-            Phase::Liquid => *fl = T::ONE,
-            Phase::Solid if material.plasticity.is_some() => return false,
-            Phase::Solid => {}
+        if *p == Phase::Liquid {
+            *fl = T::ONE;
         }
     }
     let any_liquid = phases.contains(&Phase::Liquid);
@@ -436,18 +471,26 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
     }
     let det_a = lmat::det(&inc);
     ok = ok & zero.lt(det_a);
-    // A solid (no plasticity): F_E ← A F_E, finite with a finite positive determinant
-    // (`check_det`), and it keeps `F_P`. A liquid keeps its volume ratios only, from `det A`
-    // (`liquid_step`). In a chunk of both, every lane computes both and takes its own (the
-    // other's checks do not apply); a chunk of liquids alone forms no product.
+    // A solid: F_E ← A F_E, finite with a finite positive determinant (`check_det`); without
+    // plasticity it keeps `F_P`, with snow plasticity both are clamped (`snow`). A liquid keeps
+    // its volume ratios only, from `det A` (`liquid_step`). In a chunk of both, every lane
+    // computes both and takes its own (the other's checks do not apply); a chunk of liquids
+    // alone forms no product.
     let liq = zero.lt(V::load(&liquid_flags));
     let all_liquid = any_liquid && V::all(liq);
-    let f = if all_liquid {
-        f_e // not read: every lane takes the liquid's F_E below
+    let (f, snow_fp) = if all_liquid {
+        (f_e, None) // not read: every lane takes the liquid's F_E below
     } else {
         let f = product(&inc, &f_e);
         ok = ok & (det_ok(&f) | liq);
-        f
+        match &material.plasticity {
+            Some(sn) => {
+                let (fe, fp, snow_ok) = snow(material, sn, &f, &f_p, &liquid_flags);
+                ok = ok & (snow_ok | liq);
+                (fe, Some(fp))
+            }
+            None => (f, None),
+        }
     };
     let (f, f_p_new) = if any_liquid {
         // The solid lanes' `F_P` is selected inside `liquid`, not by `Option::map` here: a
@@ -459,9 +502,14 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
         } else {
             select_mat(liq, &fe, &f)
         };
+        // Snow solids beside liquids: each lane its own `F_P`.
+        let fp = match snow_fp {
+            Some(sf) => Some(select_mat(liq, &fp.unwrap_or(f_p), &sf)),
+            None => fp,
+        };
         (f, fp)
     } else {
-        (f, None)
+        (f, snow_fp)
     };
     if !V::all(ok) {
         return false;

@@ -106,14 +106,10 @@ where
     /// Whether this call's particles take the pass on lanes: in `f32` (whose eight-lane type
     /// loads records by in-register transposes; the `f64` row types gather each component,
     /// and on AMD Zen 4 that made 3D `f64` P2G 20–40 ns per particle slower than the scalar
-    /// pass), when the moduli do not depend on the particle (no hardening).
+    /// pass).
     #[inline(always)]
     pub(super) fn lanes_ok(&self) -> bool {
         core::mem::size_of::<T>() == 4
-            && !self
-                .material
-                .plasticity
-                .is_some_and(|s| s.hardening != T::ZERO)
     }
 
     /// The pass of particles `start..start + R::LANES` into lanes `l0..` of `b`, and their
@@ -152,9 +148,8 @@ where
         {
             return None;
         }
-        let liq = zero.lt(R::load(&liq[..n]));
-        let mu = pick::<T, R>(liq, m.solid.mu, m.liquid.mu);
-        let inv_lambda = pick::<T, R>(liq, m.solid.inv_lambda, m.liquid.inv_lambda);
+        let liq_flags = liq;
+        let liq = zero.lt(R::load(&liq_flags[..n]));
 
         // The particle, as `check_particle` checks it.
         let mut x = [zero; D];
@@ -182,6 +177,27 @@ where
             lmat::det(&lmat_of::<R, D>(&fp)),
         );
         ok = ok & j_e.is_finite() & j_p.is_finite() & zero.lt(j_e) & zero.lt(j_p);
+        let (mu, inv_lambda) = if matches!(&m.plasticity, Some(s) if s.hardening != T::ZERO) {
+            // Hardened moduli at each lane's `J_P` (`Material::moduli`, one scalar call per
+            // lane); where they do not exist the scalar pass reports it.
+            let mut jp = [T::ZERO; L];
+            j_p.store(&mut jp[..n]);
+            let (mut mus, mut ils) = ([T::ZERO; L], [T::ZERO; L]);
+            for l in 0..n {
+                let phase = match liq_flags[l] == T::ZERO {
+                    true => Phase::Solid,
+                    false => Phase::Liquid,
+                };
+                let md = m.moduli(phase, jp[l]).ok()?;
+                (mus[l], ils[l]) = (md.mu, md.inv_lambda);
+            }
+            (R::load(&mus[..n]), R::load(&ils[..n]))
+        } else {
+            (
+                pick::<T, R>(liq, m.solid.mu, m.liquid.mu),
+                pick::<T, R>(liq, m.solid.inv_lambda, m.liquid.inv_lambda),
+            )
+        };
         let temp = if m.heat.is_some() {
             let t: R = load(ps.temperature, start);
             ok = ok & t.is_finite();
