@@ -477,6 +477,46 @@ AMPM_TEST_API(double, 2, f64)
 AMPM_TEST_API(double, 3, f64)
 #undef AMPM_TEST_API
 
+// ---- the particle-call symbols by (scalar, dimension) ---------------------------------------
+// One table for the tests and benchmarks of the particle calls (test_host_loop.cpp keeps its
+// own: it is a host written against ampm.h alone).
+
+template <class T, int D>
+struct PartApi;
+
+#define AMPM_PART_API(T, D, S)                                                          \
+  template <>                                                                           \
+  struct PartApi<T, D> {                                                                \
+    static constexpr const char* name = #D "D " #S;                                     \
+    static constexpr auto stencil = ampm_stencil_##D##d_##S;                            \
+    static constexpr auto node_range = ampm_node_range_##D##d_##S;                      \
+    static constexpr auto p2g = ampm_p2g_##D##d_##S;                                    \
+    static constexpr auto g2p = ampm_g2p_update_##D##d_##S;                             \
+    static constexpr auto g2p_mac = ampm_g2p_update_mac_##D##d_##S;                     \
+    static constexpr auto prepare = ampm_force_prepare_##D##d_##S;                      \
+    static constexpr auto apply = ampm_force_apply_##D##d_##S;                          \
+    static constexpr auto pressure = ampm_pressure_##D##d_##S;                          \
+    /* The same symbols by name, for a build loaded with dlopen (bench_transfers --ab). */ \
+    static constexpr const char* p2g_sym = "ampm_p2g_" #D "d_" #S;                      \
+    static constexpr const char* g2p_sym = "ampm_g2p_update_" #D "d_" #S;               \
+    static constexpr const char* prepare_sym = "ampm_force_prepare_" #D "d_" #S;        \
+    static constexpr const char* apply_sym = "ampm_force_apply_" #D "d_" #S;            \
+    static constexpr std::size_t slot_len =                                             \
+        D == 2 ? AMPM_FORCE_SLOT_LEN_2D : AMPM_FORCE_SLOT_LEN_3D;                       \
+    using Material = AmpmMaterial_##S;                                                  \
+    using Particles = AmpmParticles_##S;                                                \
+    using Channel = AmpmChannel_##S;                                                    \
+    using ConstChannel = AmpmConstChannel_##S;                                          \
+    using P2gView = AmpmP2gView_##S;                                                    \
+    using G2pView = AmpmG2pView_##S;                                                    \
+    using ForceView = AmpmForceView_##S;                                                \
+  };
+AMPM_PART_API(float, 2, f32)
+AMPM_PART_API(float, 3, f32)
+AMPM_PART_API(double, 2, f64)
+AMPM_PART_API(double, 3, f64)
+#undef AMPM_PART_API
+
 }  // namespace ampm_test
 
 #endif  // AMPM_C_TESTS_COMMON_HPP

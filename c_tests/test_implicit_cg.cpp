@@ -61,29 +61,7 @@ using namespace ampm_test;
 namespace {
 
 template <class T>
-struct Api3;
-
-#define CG_API(T, S)                                                   \
-  template <>                                                          \
-  struct Api3<T> {                                                     \
-    static constexpr const char* name = "3D " #S;                      \
-    static constexpr auto p2g = ampm_p2g_3d_##S;                       \
-    static constexpr auto g2p = ampm_g2p_update_3d_##S;                \
-    static constexpr auto node_range = ampm_node_range_3d_##S;         \
-    static constexpr auto stencil = ampm_stencil_3d_##S;               \
-    static constexpr auto prepare = ampm_force_prepare_3d_##S;         \
-    static constexpr auto apply = ampm_force_apply_3d_##S;             \
-    using Material = AmpmMaterial_##S;                                 \
-    using Particles = AmpmParticles_##S;                               \
-    using Channel = AmpmChannel_##S;                                   \
-    using ConstChannel = AmpmConstChannel_##S;                         \
-    using P2gView = AmpmP2gView_##S;                                   \
-    using G2pView = AmpmG2pView_##S;                                   \
-    using ForceView = AmpmForceView_##S;                               \
-  };
-CG_API(float, f32)
-CG_API(double, f64)
-#undef CG_API
+using Api3 = ampm_test::PartApi<T, 3>;
 
 constexpr int D = 3;
 constexpr int K1 = 3;   // quadratic: 3 nodes per axis

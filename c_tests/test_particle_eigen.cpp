@@ -47,37 +47,6 @@ using namespace ampm_test;
 
 namespace {
 
-template <class T, int D>
-struct PartApi;
-
-#define AMPM_PART_API(T, D, S)                                            \
-  template <>                                                             \
-  struct PartApi<T, D> {                                                  \
-    static constexpr const char* name = #D "d_" #S;                       \
-    static constexpr auto stencil = ampm_stencil_##D##d_##S;              \
-    static constexpr auto node_range = ampm_node_range_##D##d_##S;        \
-    static constexpr auto p2g = ampm_p2g_##D##d_##S;                      \
-    static constexpr auto g2p = ampm_g2p_update_##D##d_##S;               \
-    static constexpr auto g2p_mac = ampm_g2p_update_mac_##D##d_##S;       \
-    static constexpr auto prepare = ampm_force_prepare_##D##d_##S;        \
-    static constexpr auto apply = ampm_force_apply_##D##d_##S;            \
-    static constexpr auto pressure = ampm_pressure_##D##d_##S;            \
-    static constexpr std::size_t slot_len =                               \
-        D == 2 ? AMPM_FORCE_SLOT_LEN_2D : AMPM_FORCE_SLOT_LEN_3D;         \
-    using Material = AmpmMaterial_##S;                                    \
-    using Particles = AmpmParticles_##S;                                  \
-    using Channel = AmpmChannel_##S;                                      \
-    using ConstChannel = AmpmConstChannel_##S;                            \
-    using P2gView = AmpmP2gView_##S;                                      \
-    using G2pView = AmpmG2pView_##S;                                      \
-    using ForceView = AmpmForceView_##S;                                  \
-  };
-AMPM_PART_API(float, 2, f32)
-AMPM_PART_API(float, 3, f32)
-AMPM_PART_API(double, 2, f64)
-AMPM_PART_API(double, 3, f64)
-#undef AMPM_PART_API
-
 constexpr std::uint64_t kSeed = 0x5eed'a3b1'2014'0004ULL;
 
 // ---- the independent reference ------------------------------------------------------------

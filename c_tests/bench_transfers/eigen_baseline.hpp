@@ -49,6 +49,26 @@ struct Mags {
 /// matrices, plain arrays in the node loop (GCC 12 spills Eigen's fixed 3-vectors through the
 /// stack there, which costs a store-forwarding stall per node). With `mags` (the long-double
 /// reference) also the per-node magnitudes.
+/// Stencil node `r` (axis 0 fastest) of per-axis weights `w`, `dw`: its offsets `o` from the
+/// base node, weight `wt`, weight gradient `gr` and grid index (`k0` the index of the base node,
+/// `st` the strides).
+template <class T, int D>
+inline std::ptrdiff_t stencil_node(int r, const T (&w)[D][K1], const T (&dw)[D][K1], std::ptrdiff_t k0,
+                                   const std::ptrdiff_t* st, int (&o)[D], T& wt, T (&gr)[D]) {
+  for (int a = 0, q = r; a < D; ++a, q /= K1) o[a] = q % K1;
+  wt = 1;
+  std::ptrdiff_t k = k0;
+  for (int a = 0; a < D; ++a) {
+    wt *= w[a][o[a]];
+    k += o[a] * st[a];
+    T ga = dw[a][o[a]];
+    for (int b = 0; b < D; ++b)
+      if (b != a) ga *= w[b][o[b]];
+    gr[a] = ga;
+  }
+  return k;
+}
+
 template <class T, int D>
 __attribute__((noinline)) void eigen_p2g(const Parts<T, D>& p, Grid<T, D>& g, T h, T dt, T mu, T lambda,
                                          Mags* mags) {
@@ -81,17 +101,8 @@ __attribute__((noinline)) void eigen_p2g(const Parts<T, D>& p, Grid<T, D>& g, T 
     }
     for (int r = 0; r < KD; ++r) {
       int o[D];
-      for (int a = 0, q = r; a < D; ++a, q /= K1) o[a] = q % K1;
-      T wt = 1, gr[D];
-      std::ptrdiff_t k = k0;
-      for (int a = 0; a < D; ++a) {
-        wt *= w[a][o[a]];
-        k += o[a] * st[a];
-        T ga = dw[a][o[a]];
-        for (int b = 0; b < D; ++b)
-          if (b != a) ga *= w[b][o[b]];
-        gr[a] = ga;
-      }
+      T wt, gr[D];
+      const std::ptrdiff_t k = stencil_node<T, D>(r, w, dw, k0, st, o, wt, gr);
       mass[k] += wt * m;
       for (int a = 0; a < D; ++a) {
         T q = q0[a], f = 0;
@@ -138,17 +149,8 @@ __attribute__((noinline)) void eigen_g2p(Parts<T, D>& p, const Grid<T, D>& g, T 
     T v[D] = {}, so[D][D] = {}, gv[D][D] = {};
     for (int r = 0; r < KD; ++r) {
       int o[D];
-      for (int a = 0, q = r; a < D; ++a, q /= K1) o[a] = q % K1;
-      T wt = 1, gr[D];
-      std::ptrdiff_t k = k0;
-      for (int a = 0; a < D; ++a) {
-        wt *= w[a][o[a]];
-        k += o[a] * st[a];
-        T ga = dw[a][o[a]];
-        for (int c = 0; c < D; ++c)
-          if (c != a) ga *= w[c][o[c]];
-        gr[a] = ga;
-      }
+      T wt, gr[D];
+      const std::ptrdiff_t k = stencil_node<T, D>(r, w, dw, k0, st, o, wt, gr);
       for (int a = 0; a < D; ++a) {
         const T vi = vel[a][k], wv = wt * vi;
         v[a] += wv;

@@ -46,37 +46,7 @@ constexpr int K1 = 3;  // quadratic: 3 nodes per axis
 // ---- the C symbols by (scalar, dimension) --------------------------------------------------
 
 template <class T, int D>
-struct Api;
-
-#define BENCH_API(T, D, S)                                              \
-  template <>                                                           \
-  struct Api<T, D> {                                                    \
-    static constexpr const char* name = #D "D " #S;                     \
-    static constexpr auto p2g = ampm_p2g_##D##d_##S;                    \
-    static constexpr auto g2p = ampm_g2p_update_##D##d_##S;             \
-    static constexpr auto node_range = ampm_node_range_##D##d_##S;      \
-    static constexpr auto prepare = ampm_force_prepare_##D##d_##S;      \
-    static constexpr auto apply = ampm_force_apply_##D##d_##S;          \
-    /* The same symbols by name, for a build loaded with dlopen (--ab). */ \
-    static constexpr const char* p2g_sym = "ampm_p2g_" #D "d_" #S;      \
-    static constexpr const char* g2p_sym = "ampm_g2p_update_" #D "d_" #S; \
-    static constexpr const char* prepare_sym = "ampm_force_prepare_" #D "d_" #S; \
-    static constexpr const char* apply_sym = "ampm_force_apply_" #D "d_" #S; \
-    static constexpr std::size_t slot_len =                             \
-        D == 2 ? AMPM_FORCE_SLOT_LEN_2D : AMPM_FORCE_SLOT_LEN_3D;       \
-    using Material = AmpmMaterial_##S;                                  \
-    using Particles = AmpmParticles_##S;                                \
-    using Channel = AmpmChannel_##S;                                    \
-    using ConstChannel = AmpmConstChannel_##S;                          \
-    using P2gView = AmpmP2gView_##S;                                    \
-    using G2pView = AmpmG2pView_##S;                                    \
-    using ForceView = AmpmForceView_##S;                                \
-  };
-BENCH_API(float, 2, f32)
-BENCH_API(float, 3, f32)
-BENCH_API(double, 2, f64)
-BENCH_API(double, 3, f64)
-#undef BENCH_API
+using Api = ampm_test::PartApi<T, D>;
 
 [[noreturn]] inline void fail(const std::string& msg) {
   std::fprintf(stderr, "bench_transfers: %s\n", msg.c_str());

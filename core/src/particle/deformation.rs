@@ -46,6 +46,7 @@
 //! [`Error::NonPositiveJ`]. See [`check_det`].
 
 use crate::error::{Error, Result};
+use crate::kernel::select_mat;
 use crate::lane::lmat::{self, mul_diag_nt, LMat};
 use crate::lane::Lane;
 use crate::mat::{Mat, Matrix};
@@ -262,18 +263,9 @@ pub(crate) fn snow_lanes<V: Lane, const D: usize>(
     }
     let fe = mul_diag_nt(&svd.u, &clamped, &svd.v);
     let fp = lmat::mul(&mul_diag_nt(&svd.v, &ratio, &svd.v), f_p);
-    let keep = |a: &LMat<V, D>, b: &LMat<V, D>| {
-        let mut r = *b;
-        for (cr, ca) in r.iter_mut().zip(a) {
-            for (x, y) in cr.iter_mut().zip(ca) {
-                *x = V::select(same, *y, *x);
-            }
-        }
-        r
-    };
     SnowLanes {
-        f_e: keep(f_e, &fe),
-        f_p: keep(f_p, &fp),
+        f_e: select_mat(same, f_e, &fe),
+        f_p: select_mat(same, f_p, &fp),
         positive,
     }
 }

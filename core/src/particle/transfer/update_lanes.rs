@@ -32,6 +32,7 @@
 mod heat;
 
 use super::{rd, wr, Checked, Particles};
+use crate::kernel::select_mat;
 use crate::lane::lmat::{self, LMat};
 use crate::lane::Lane;
 use crate::particle::deformation::{snow_bounds, snow_lanes};
@@ -275,18 +276,6 @@ fn snow<T: Real, V: Lane<Scalar = T>, const D: usize>(
     (out.f_e, out.f_p, ok)
 }
 
-/// `a` on the lanes of `m`, `b` on the others.
-#[inline(always)]
-fn select_mat<V: Lane, const D: usize>(m: V::Mask, a: &LMat<V, D>, b: &LMat<V, D>) -> LMat<V, D> {
-    let mut r = *b;
-    for (cr, ca) in r.iter_mut().zip(a.iter()) {
-        for (x, y) in cr.iter_mut().zip(ca.iter()) {
-            *x = V::select(m, *y, *x);
-        }
-    }
-    r
-}
-
 /// `s I`.
 #[inline(always)]
 fn diagonal<V: Lane, const D: usize>(s: V) -> LMat<V, D> {
@@ -336,12 +325,7 @@ fn liquid<T: Real, V: Lane<Scalar = T>, const D: usize>(
         return (fe, None, ok);
     }
     let (r_p, ok_p) = root_det(f_p);
-    let mut fp = diagonal::<V, D>(r_p);
-    for (cn, c) in fp.iter_mut().zip(f_p.iter()) {
-        for (xn, x) in cn.iter_mut().zip(c.iter()) {
-            *xn = V::select(keep, *x, *xn);
-        }
-    }
+    let fp = select_mat(keep, f_p, &diagonal::<V, D>(r_p));
     ok = ok & (keep | (ok_p & det_ok(&fp)));
     (fe, Some(fp), ok)
 }
