@@ -4,8 +4,10 @@
 //   bench_transfers [--out FILE] [--reps R]   time every case, markdown table to stdout and FILE
 //                                             (default docs/bench-transfers.md)
 //   bench_transfers --check                   tiny sizes, agreement checks only (for ctest)
-//   bench_transfers --ab A.so B.so [--reps R] two builds of libampm.so, loaded with dlopen, timed
-//                                             alternately call by call (A/B comparison)
+//   bench_transfers --ab A.so B.so [--reps R] [--block N]
+//                                             two builds of libampm.so, loaded with dlopen, timed
+//                                             alternately call by call (A/B comparison); with
+//                                             --block, P2G, G2P and apply in calls of N particles
 //
 // This file holds the command line; the parts are in c_tests/bench_transfers/: host.hpp (the
 // workload: scenes, particles, the host's grid), eigen_baseline.hpp, case.hpp (one case and
@@ -71,7 +73,8 @@
 // builds must return AMPM_OK and the same results, bit for bit (P2G's node channels; G2P's
 // particle positions, velocities, C, F_E, F_P, temperatures, latent buffers and phases;
 // prepare's slots; apply's forces), checked before timing: a performance change must not
-// change them.
+// change them. With --block N, P2G, G2P and apply run in calls of N consecutive particles (a
+// threaded host's blocks, as in the block timing), which weighs each call's fixed cost.
 //
 // --check (and every timing run, before timing): on tiny blocks (6³, 14²), every call returns
 // AMPM_OK with first_failed = n and finite results; for the elastic scene the library's and the
@@ -102,7 +105,9 @@ namespace bench {
   std::fprintf(code == 0 ? stdout : stderr,
                "usage: bench_transfers [--out FILE] [--reps R]   time every case (default FILE docs/bench-transfers.md)\n"
                "       bench_transfers --check                   agreement checks only, tiny sizes\n"
-               "       bench_transfers --ab A.so B.so [--reps R] two builds of libampm.so timed alternately\n");
+               "       bench_transfers --ab A.so B.so [--reps R] [--block N]\n"
+               "                 two builds of libampm.so timed alternately (P2G, G2P and apply in calls of\n"
+               "                 N particles with --block; default one call)\n");
   std::exit(code);
 }
 
@@ -118,6 +123,7 @@ int main(int argc, char** argv) {
   bool out_given = false;
   std::string ab[2];
   bool reps_given = false;
+  std::size_t block = 0;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--check") {
@@ -128,6 +134,10 @@ int main(int argc, char** argv) {
     } else if (arg == "--out" && i + 1 < argc) {
       out = argv[++i];
       out_given = true;
+    } else if (arg == "--block" && i + 1 < argc) {
+      const long b = std::atol(argv[++i]);
+      if (b < 1) fail("--block wants a positive particle count");
+      block = static_cast<std::size_t>(b);
     } else if (arg == "--reps" && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
       if (reps < 1 || reps > 1000) fail("--reps wants 1..1000");
@@ -139,7 +149,7 @@ int main(int argc, char** argv) {
       usage(2);
     }
   }
-  if (!ab[0].empty()) return run_ab(ab[0], ab[1], reps_given ? reps : 31);
+  if (!ab[0].empty()) return run_ab(ab[0], ab[1], reps_given ? reps : 31, block);
   const std::uint32_t default_isa = ampm_isa();
   std::vector<std::uint32_t> isas;
   for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}, std::uint32_t{AMPM_ISA_SCALAR}})

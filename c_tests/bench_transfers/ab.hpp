@@ -4,6 +4,7 @@
 
 #include <dlfcn.h>
 
+#include "blocks.hpp"
 #include "case.hpp"
 
 namespace bench {
@@ -57,9 +58,11 @@ struct AbRow {
   double t[kAbN][2] = {};
 };
 
-/// Times one case on instruction set `isa` with both builds alternately (see the header).
+/// Times one case on instruction set `isa` with both builds alternately (see the header), the
+/// particles in calls of `block` (0: one call per transfer).
 template <class T, int D>
-void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* libs[2], std::vector<AbRow>& rows) {
+void ab_case(Scene s, int per_axis, int reps, std::size_t block, std::uint32_t isa, const AbLib* libs[2],
+             std::vector<AbRow>& rows) {
   for (int k = 0; k < 2; ++k)
     if (libs[k]->set_isa(isa) != AMPM_OK) return;
   Case<T, D> cs(s, per_axis);
@@ -69,12 +72,20 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
   auto check = [&](int k, const char* what, AmpmStatus st) {
     expect_ok(cs.label(what) + " (" + libs[k]->path + ")", st, ff, n);
   };
-  auto p2g = [&](int k) { check(k, "P2G sym", cs.p2g_sym(&ff, fns[k].p2g)); };
-  auto g2p = [&](int k) { check(k, "G2P", cs.g2p(&ff, fns[k].g2p)); };
+  auto p2g = [&](int k) {
+    in_blocks(cs, block, "P2G sym", [&](std::size_t i, std::size_t m, std::size_t* f) {
+      return cs.p2g_sym_range(i, m, f, fns[k].p2g);
+    });
+  };
+  auto g2p = [&](int k) {
+    in_blocks(cs, block, "G2P",
+              [&](std::size_t i, std::size_t m, std::size_t* f) { return cs.g2p_range(i, m, f, fns[k].g2p); });
+  };
   auto prepare = [&](int k) { check(k, "prepare", cs.prepare(&ff, fns[k].prepare)); };
   auto apply = [&](int k) {
     cs.zero_df();
-    check(k, "apply", cs.apply(&ff, fns[k].apply));
+    in_blocks(cs, block, "apply",
+              [&](std::size_t i, std::size_t m, std::size_t* f) { return cs.apply_range(i, m, f, fns[k].apply); });
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
   auto ns = [&](auto t0, auto t1) { return ns_per(t0, t1, n); };
@@ -143,17 +154,19 @@ void ab_case(Scene s, int per_axis, int reps, std::uint32_t isa, const AbLib* li
 }
 
 /// The A/B comparison (--ab): a markdown table of both builds' medians and their ratio.
-inline int run_ab(const std::string& a, const std::string& b, int reps) {
+inline int run_ab(const std::string& a, const std::string& b, int reps, std::size_t block) {
   const AbLib la(a), lb(b);
   const AbLib* libs[2] = {&la, &lb};
   std::vector<AbRow> rows;
   for (Scene s : {Scene::Elastic, Scene::Fluid, Scene::Thermal})
     for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}}) {
-      ab_case<float, 3>(s, 38, reps, isa, libs, rows);
-      ab_case<float, 2>(s, 234, reps, isa, libs, rows);
+      ab_case<float, 3>(s, 38, reps, block, isa, libs, rows);
+      ab_case<float, 2>(s, 234, reps, block, isa, libs, rows);
     }
   std::ostringstream o;
-  o << "A/B (bench_transfers --ab, " << reps << " reps, alternating): A = `" << a << "`, B = `" << b << "`\n"
+  o << "A/B (bench_transfers --ab, " << reps << " reps, alternating, "
+    << (block == 0 ? std::string("one call per transfer") : "calls of " + std::to_string(block) + " particles")
+    << "): A = `" << a << "`, B = `" << b << "`\n"
     << "CPU: " << cpu_model() << "; load before: " << load_average() << "\n\n"
     << "| scene | case | ISA |";
   for (const char* c : kAbCalls) o << " " << c << " A | " << c << " B | B / A |";

@@ -8,7 +8,8 @@
 /// With AVX-512 it also says whether the particle transfers put two eight-lane rows in one
 /// sixteen-lane register ([`Isa::joined_rows`]): on by default where 512-bit operations run at
 /// the full rate of two 256-bit ones without slowing the rest (AMD Zen 5 and later), off
-/// elsewhere (on an Intel Xeon the joined rows measured 7–13% slower).
+/// elsewhere (the joined rows measured 7–13% slower on an Intel Xeon, and P2G and apply 3–10%
+/// slower on AMD Zen 4, whose 512-bit operations take two 256-bit passes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Isa(IsaKind, bool);
 
