@@ -69,22 +69,29 @@ void ab_case(Scene s, int per_axis, int reps, std::size_t block, std::uint32_t i
   const AbFns<T, D> fns[2] = {AbFns<T, D>(*libs[0]), AbFns<T, D>(*libs[1])};
   const std::size_t n = cs.p.n;
   std::size_t ff = 0;
-  auto check = [&](int k, const char* what, AmpmStatus st) {
-    expect_ok(cs.label(what) + " (" + libs[k]->path + ")", st, ff, n);
+  // A call's name with its build's path, made once, so that a failure says which build failed.
+  auto named = [&](const char* call) {
+    return std::array<std::string, 2>{std::string(call) + " (" + libs[0]->path + ")",
+                                      std::string(call) + " (" + libs[1]->path + ")"};
   };
+  const auto p2g_name = named("P2G sym"), g2p_name = named("G2P"), apply_name = named("apply");
+  const auto prepare_name = named("prepare");
   auto p2g = [&](int k) {
-    in_blocks(cs, block, "P2G sym", [&](std::size_t i, std::size_t m, std::size_t* f) {
+    in_blocks(cs, block, p2g_name[k].c_str(), [&](std::size_t i, std::size_t m, std::size_t* f) {
       return cs.p2g_sym_range(i, m, f, fns[k].p2g);
     });
   };
   auto g2p = [&](int k) {
-    in_blocks(cs, block, "G2P",
+    in_blocks(cs, block, g2p_name[k].c_str(),
               [&](std::size_t i, std::size_t m, std::size_t* f) { return cs.g2p_range(i, m, f, fns[k].g2p); });
   };
-  auto prepare = [&](int k) { check(k, "prepare", cs.prepare(&ff, fns[k].prepare)); };
+  auto prepare = [&](int k) {
+    const AmpmStatus st = cs.prepare(&ff, fns[k].prepare);  // before `ff` is read
+    expect_ok(cs.label(prepare_name[k].c_str()), st, ff, n);
+  };
   auto apply = [&](int k) {
     cs.zero_df();
-    in_blocks(cs, block, "apply",
+    in_blocks(cs, block, apply_name[k].c_str(),
               [&](std::size_t i, std::size_t m, std::size_t* f) { return cs.apply_range(i, m, f, fns[k].apply); });
   };
   auto clock = [] { return std::chrono::steady_clock::now(); };
