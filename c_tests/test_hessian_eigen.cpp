@@ -11,7 +11,7 @@
 // vec(Ĉ:Z) = Ĉ · vec(Z).
 //
 // Tolerance: 32·ε·κ relative to ‖Ĉ‖_F (actions: ‖Ĉ‖_F‖Z‖_F), κ = σ_max/σ_min of F, ε of the
-// precision under test; derived in tests/hessian.rs: a backward-stable SVD (≈ 2d·ε·‖F‖ in F),
+// precision under test; derived in tests/hessian/main.rs: a backward-stable SVD (≈ 2d·ε·‖F‖ in F),
 // Ĉ homogeneous of degree −2 with σᵢσⱼ denominators (relative sensitivity 2/σ_min), the PSD
 // projection 1-Lipschitz in the Frobenius norm; that budget (8d ≤ 24 < 32) counts two
 // double-precision sides, here the reference is long double, so it holds with margin. On top,

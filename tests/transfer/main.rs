@@ -2,24 +2,25 @@
 //! set of this CPU. One test binary; each module covers one transfer:
 //!
 //! 1. `p2g`: P2G equals the per-particle reference (`update::p2g` and `P2g::node`, accumulated
-//!    in f64) within the rounding of the SIMD stress (bounded in tests/batch.rs) and of the
+//!    in f64) within the rounding of the SIMD stress (bounded in tests/batch/paths.rs) and of the
 //!    sums; interleaved node structs give the same bits as separate arrays; a particle's
 //!    contribution does not depend on its index in the batch (for every material: the
 //!    per-particle pass on lanes gives the bits of the one-by-one pass). MAC P2G conserves
 //!    mass and momentum on every face grid and its forces sum to zero.
 //! 2. `g2p`: G2P equals the per-particle reference (`g2p_update` on the gathered stencil
-//!    values); on a linear velocity field (collocated and MAC) it reproduces `v = v₀ + A x`,
-//!    `C = A`, `∇v = A` (B-splines reproduce linear functions; an independent check of the node
-//!    loops). NaN in a node that is read fails the particle; NaN in nodes no stencil reads is
-//!    harmless.
-//! 3. `failures`: outside the box, overflow (large m·v, large heat capacity, tiny h): the
+//!    values); a batch (with and without heat) gives the bits of calls of one particle.
+//! 3. `g2p_nodes`: on a linear velocity field (collocated and MAC) G2P reproduces
+//!    `v = v₀ + A x`, `C = A`, `∇v = A` (B-splines reproduce linear functions; an independent
+//!    check of the node loops). NaN in a node that is read fails the particle; NaN in nodes no
+//!    stencil reads is harmless.
+//! 4. `failures`: outside the box, overflow (large m·v, large heat capacity, tiny h): the
 //!    status, the first index, and nothing written (grid and particle bits unchanged).
-//! 4. `force`: the force differential: exact mode equals `Stiffness::d_force_matrix` (itself
-//!    checked by finite differences in tests/particle.rs); `K` is symmetric; with the PSD
+//! 5. `force`: the force differential: exact mode equals `Stiffness::d_force_matrix` (itself
+//!    checked by finite differences in tests/particle/stiffness.rs); `K` is symmetric; with the PSD
 //!    option `⟨δu, K δu⟩ ≤ 0` for every `δu`, including a dilational part that is indefinite,
 //!    and it equals the exact differential where that is already definite; unprepared slots
 //!    are refused.
-//! 5. `layouts`: G2P and the force differential give the same bits on separate node arrays,
+//! 6. `layouts`: G2P and the force differential give the same bits on separate node arrays,
 //!    interleaved node structs and arrays of different strides (the read paths of the node
 //!    sums), and the same bits on every vector instruction set.
 //!
@@ -28,6 +29,7 @@
 mod failures;
 mod force;
 mod g2p;
+mod g2p_nodes;
 mod layouts;
 mod p2g;
 

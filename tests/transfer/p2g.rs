@@ -90,7 +90,7 @@ fn nd_dx<T: Real, const D: usize>(s: &Stencil<T, D>, k: usize, b: usize) -> f64 
 }
 
 /// A bound on the difference between the transfer and the reference at one node: the SIMD
-/// stress differs from the scalar one by at most 512ε of its scale (tests/batch.rs bounds the
+/// stress differs from the scalar one by at most 512ε of its scale (tests/batch/paths.rs bounds the
 /// kernels at that), each contribution carries ≤ 16 roundings, and the node sums ≤ 64 more.
 fn p2g_tol<T: Real>() -> f64 {
     (512.0 + 16.0 + 64.0) * T::EPSILON.to_f64()

@@ -15,13 +15,13 @@
 //! `≤ c·u'·κ` with a modest `c` and the condition `κ` of the problem at that input. Run in
 //! double-double, `u' ≈ 2⁻¹⁰⁴ ≈ 5e-32`, so the reference's own error is `~1e-15` of the f64
 //! error being measured (in units of `ε_f64·κ` it contributes `≤ 1e-15·c`), and every input is
-//! converted to double-double exactly (the reference sees the very `F` the method saw, after
-//! its rounding to f32 or f64). What this cannot catch is an error in the *formulas* (the
-//! same generic source computes both sides); those are checked independently: `Â` and `Ĉ:Z`
-//! against finite differences of `Ψ̂` (`tests/kernels.rs`, `tests/hessian.rs`) and against
-//! an Eigen implementation of the seed's formulas in long double (`c_tests/`). The reference
-//! SVD itself is checked in `tests/stability.rs`: it reconstructs `F` to `~1e-30` relative and
-//! `U`, `V` are orthonormal to that level.
+//! converted to double-double exactly (the reference sees the very `F` the method saw, after its
+//! rounding to f32 or f64). What this cannot catch is an error in the *formulas* (the same generic
+//! source computes both sides); those are checked independently: `Â` and `Ĉ:Z` against finite
+//! differences of `Ψ̂` (`tests/kernels/precision.rs`, `tests/hessian/brute_force.rs`) and against
+//! an Eigen implementation of the seed's formulas in long double (`c_tests/`). The reference SVD
+//! itself is checked in `tests/stability/contracts.rs`: it reconstructs `F` to `~1e-30` relative
+//! and `U`, `V` are orthonormal to that level.
 //!
 //! The transcendental functions of `twofloat` (`exp`, `ln`, `powf`, `sin_cos`, `atan2`) are
 //! "preliminary" in its own words; the kernels do not use them (only `+ − × ÷ √ ∛`).

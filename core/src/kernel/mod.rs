@@ -81,7 +81,7 @@ impl LaneDim<3> for Dim<3> {
     fn eigen_sweeps<T: Real>() -> u32 {
         // Cyclic Jacobi on a 3×3 symmetric matrix converges quadratically. Measured: the
         // smallest counts that pass the long-double PSD checks (c_tests/test_hessian_eigen)
-        // and tests/hessian.rs; one fewer fails them.
+        // and tests/hessian/; one fewer fails them.
         if T::MANTISSA_DIGITS <= 24 {
             3
         } else if T::MANTISSA_DIGITS <= 53 {

@@ -20,7 +20,7 @@
 //! multiply-add is a ~6 ns software routine, so it rounds `a·b + c` twice; its reciprocal
 //! square roots are `1/√x` (lower latency for one particle than a Newton chain); and it skips
 //! Jacobi rotations of pairs already orthogonal. It agrees with the vector paths to a few
-//! roundings amplified by the conditioning of `F` (bounds tested in `tests/batch.rs` and
+//! roundings amplified by the conditioning of `F` (bounds tested in `tests/batch/paths.rs` and
 //! `c_tests/`).
 
 use crate::scalar::Real;

@@ -29,7 +29,7 @@
 //! limited by the Jacobi off-diagonal left after the last sweep: the approximate rotation
 //! reduces `|S_pq|` by at least the factor of the `π/8` fallback (paper §2.2) in the first
 //! sweeps and converges quadratically once the angles are small; 4 sweeps reach f32 rounding
-//! for well-conditioned `F`, f64 needs more (measured by `tests/batch.rs` and the report).
+//! for well-conditioned `F`, f64 needs more (measured by `tests/batch/mcadams.rs` and the report).
 //! Sweep counts 2–8 are the sensible range; [`McAdams::new`] accepts 1–16.
 
 #![allow(clippy::needless_range_loop)]

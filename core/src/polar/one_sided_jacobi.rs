@@ -8,7 +8,7 @@
 //! [`jacobi_rotation`]) makes two columns orthogonal; a sweep visits the pairs (0,1), (0,2), (1,2). There is
 //! no stopping test: cyclic Jacobi converges quadratically, and the sweep count per precision
 //! ([`OneSidedJacobi::sweeps_for`]) is the smallest that meets every contract of the stability
-//! families (`tests/stability.rs`, measured by `ampm-report`). A rotation of two already
+//! families (`tests/stability/contracts.rs`, measured by `ampm-report`). A rotation of two already
 //! orthogonal columns is the identity to rounding, so extra sweeps cost time, not accuracy.
 //! Then `σᵢ = ‖aᵢ‖`, `uᵢ = aᵢ/σᵢ`.
 //!
@@ -35,11 +35,11 @@ pub struct OneSidedJacobi {
 }
 
 impl OneSidedJacobi {
-    /// The default sweep count of a precision with `mantissa_digits` bits: 3 for f32, 4 for
-    /// f64, 24 for the double-double reference. Measured, not guessed: these are the smallest
-    /// counts with which every stability contract (`tests/stability.rs`, all families, every
-    /// instruction set) and the accuracy acceptance of `tests/batch.rs` hold; one sweep fewer
-    /// leaves relative errors of 2.7e-2 (f32) and 1.9e-7 (f64) on σ ∈ [0.2, 5].
+    /// The default sweep count of a precision with `mantissa_digits` bits: 3 for f32, 4 for f64, 24
+    /// for the double-double reference. Measured, not guessed: these are the smallest counts with
+    /// which every stability contract (`tests/stability/contracts.rs`, all families, every
+    /// instruction set) and the accuracy acceptance of `tests/batch/accuracy.rs` hold; one sweep
+    /// fewer leaves relative errors of 2.7e-2 (f32) and 1.9e-7 (f64) on σ ∈ [0.2, 5].
     #[inline]
     #[must_use]
     pub const fn sweeps_for(mantissa_digits: u32) -> u32 {

@@ -1,5 +1,5 @@
 //! The stencils on SIMD lanes ([`Stencil::new_lanes`]) against the one-lane [`Stencil::new`]
-//! (which `tests/particle.rs` checks against an independent f64 B-spline), bit for
+//! (which `tests/particle/stencil.rs` checks against an independent f64 B-spline), bit for
 //! bit, on every lane type the CPU has.
 
 use super::{quadratic_axis, Grid, Kernel, Stencil, StencilLanes, MAX_CELLS, MAX_WIDTH};
