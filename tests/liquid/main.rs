@@ -25,6 +25,8 @@
 //! `d · δ · perm(|M|)` to first order (Laplace expansion along each row).
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+#[path = "../common/mod.rs"]
+mod common;
 #[macro_use]
 mod property;
 #[macro_use]
@@ -38,13 +40,15 @@ use ampm_core::particle::update::{
     check_particle, force_differential, p2g, update_particle, G2pSample,
 };
 use ampm_core::particle::{
-    g2p_update, Definiteness, Dilation, Grid, GridSample, Heat, Kernel, Material, Particle, Phase,
-    PhaseParams, Snow, Stencil,
+    g2p_update, Grid, GridSample, Kernel, Material, Particle, Phase, PhaseParams, Snow, Stencil,
 };
 use ampm_core::polar::{DefaultSvd, SvdMethod};
 use ampm_core::{Error, Mat, Matrix, Real};
+use ampm_tools::workload::HaarRotation;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+
+use common::heat_material;
 
 fn rng(seed: u64) -> Pcg64 {
     Pcg64::seed_from_u64(seed)
@@ -160,33 +164,6 @@ fn plastic<T: Real>() -> Material<T> {
     }
 }
 
-fn heat_material<T: Real>(phase_change: bool) -> Material<T> {
-    let f = T::from_f64;
-    Material {
-        solid: PhaseParams {
-            mu: f(10.0),
-            inv_lambda: f(0.05),
-            heat_capacity: f(2.0),
-            conductivity: f(1.0),
-        },
-        liquid: PhaseParams {
-            mu: T::ZERO,
-            inv_lambda: f(0.05),
-            heat_capacity: f(4.0),
-            conductivity: f(0.5),
-        },
-        plasticity: None,
-        heat: Some(Heat {
-            flip: f(0.9),
-            melting_point: f(273.0),
-            latent_heat: f(100.0),
-            phase_change,
-        }),
-        dilation: Dilation::Explicit,
-        hessian: Definiteness::Exact,
-    }
-}
-
 fn quiet<T: Real, const D: usize>(p: &Particle<T, D>) -> G2pSample<T, D> {
     G2pSample {
         v: [T::ZERO; D],
@@ -229,60 +206,19 @@ where
     }
 }
 
-/// A random rotation: an angle in 2D, a unit quaternion in 3D.
-fn rotation<const D: usize>(r: &mut Pcg64) -> [[f64; D]; D] {
-    let mut m = [[0.0; D]; D];
-    if D == 2 {
-        let (s, c) = r.random_range(0.0..core::f64::consts::TAU).sin_cos();
-        m[0][0] = c;
-        m[0][1] = -s;
-        m[1][0] = s;
-        m[1][1] = c;
-        return m;
-    }
-    let q = loop {
-        let q: [f64; 4] = core::array::from_fn(|_| r.random_range(-1.0..1.0));
-        let n = q.iter().map(|x| x * x).sum::<f64>();
-        if n > 0.01 && n <= 1.0 {
-            let n = n.sqrt();
-            break q.map(|x| x / n);
-        }
-    };
-    let [w, x, y, z] = q;
-    let rm = [
-        [
-            1.0 - 2.0 * (y * y + z * z),
-            2.0 * (x * y - w * z),
-            2.0 * (x * z + w * y),
-        ],
-        [
-            2.0 * (x * y + w * z),
-            1.0 - 2.0 * (x * x + z * z),
-            2.0 * (y * z - w * x),
-        ],
-        [
-            2.0 * (x * z - w * y),
-            2.0 * (y * z + w * x),
-            1.0 - 2.0 * (x * x + y * y),
-        ],
-    ];
-    for i in 0..D {
-        for j in 0..D {
-            m[i][j] = rm[i][j];
-        }
-    }
-    m
-}
-
 /// `R diag(σ) Sᵀ` rounded to `T`.
-fn with_singular_values<T: Real, const D: usize>(r: &mut Pcg64, sigma: [f64; D]) -> Mat<T, D> {
-    let a = rotation::<D>(r);
-    let b = rotation::<D>(r);
+/// (`R`, `S` Haar-random rotations, `ampm_tools::workload::HaarRotation`.)
+fn with_singular_values<T: Real, const D: usize>(r: &mut Pcg64, sigma: [f64; D]) -> Mat<T, D>
+where
+    Mat<f64, D>: HaarRotation,
+{
+    let a = Mat::<f64, D>::haar(r);
+    let b = Mat::<f64, D>::haar(r);
     let mut m = [[0.0; D]; D];
     for i in 0..D {
         for j in 0..D {
             for k in 0..D {
-                m[i][j] += a[i][k] * sigma[k] * b[j][k];
+                m[i][j] += a.cols[k][i] * sigma[k] * b.cols[k][j];
             }
         }
     }

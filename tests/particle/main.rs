@@ -14,6 +14,8 @@
 //! `(n + k)·ε` times the sum of the magnitudes.
 #![allow(clippy::needless_range_loop)] // index loops mirror the formulas
 
+#[path = "../common/mod.rs"]
+mod common;
 #[macro_use]
 mod affine;
 #[macro_use]
@@ -31,12 +33,14 @@ use ampm_core::particle::dilation;
 use ampm_core::particle::thermal::{absorb, HeatSplit, ThermalState};
 use ampm_core::particle::update::{self, elastic_energy, force_differential, Stiffness};
 use ampm_core::particle::{
-    g2p_update, kirchhoff_stress, Definiteness, Dilation, Grid, GridSample, Heat, Kernel, Material,
+    g2p_update, kirchhoff_stress, Definiteness, Dilation, Grid, GridSample, Kernel, Material,
     Particle, Phase, PhaseParams, Snow, Stencil,
 };
 use ampm_core::{Error, Mat, Matrix, Real};
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
+
+use common::heat_material;
 
 /// Independent 1D B-splines in f64 (Steffen, Kirby, Berzins 2008, written out again).
 fn bspline(k: Kernel, d: f64) -> f64 {
@@ -52,33 +56,6 @@ fn bspline(k: Kernel, d: f64) -> f64 {
 
 fn rng(seed: u64) -> Pcg64 {
     Pcg64::seed_from_u64(seed)
-}
-
-fn heat_material<T: Real>() -> Material<T> {
-    let f = T::from_f64;
-    Material {
-        solid: PhaseParams {
-            mu: f(10.0),
-            inv_lambda: f(0.05),
-            heat_capacity: f(2.0),
-            conductivity: f(1.0),
-        },
-        liquid: PhaseParams {
-            mu: T::ZERO,
-            inv_lambda: f(0.05),
-            heat_capacity: f(4.0),
-            conductivity: f(0.5),
-        },
-        plasticity: None,
-        heat: Some(Heat {
-            flip: f(0.9),
-            melting_point: f(273.0),
-            latent_heat: f(100.0),
-            phase_change: true,
-        }),
-        dilation: Dilation::Explicit,
-        hessian: Definiteness::Exact,
-    }
 }
 
 macro_rules! particle_tests {

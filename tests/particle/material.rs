@@ -39,7 +39,7 @@ macro_rules! material_tests {
         /// (c_s = 2, c_l = 4, T_m = 273, L = 100).
         #[test]
         fn latent_heat() {
-            let mat = heat_material::<T>();
+            let mat = heat_material::<T>(true);
             let heat = mat.heat.unwrap();
             let st = |t: T, u: T, ph| ThermalState {
                 temperature: t,
@@ -157,7 +157,7 @@ macro_rules! material_tests {
             let jp = Matrix::det(&q2.f_p) as f64;
             assert!((jp - 1.2 / 1.0075).abs() <= 64.0 * EPS);
             // Heat on without temperatures is refused, the particle left as it was.
-            let hm = heat_material::<T>();
+            let hm = heat_material::<T>(true);
             assert_eq!(
                 g2p_update(&hm, Kernel::Quadratic, h, 0.1, &grid, &p).map(|_| ()),
                 Err(Error::InvalidArgument)
