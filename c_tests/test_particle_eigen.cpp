@@ -61,16 +61,16 @@ namespace {
 template <class T, int D>
 void run(Checker& ck, bool pressure_solve) {
   Case<T, D> cs(ck, pressure_solve);
-  check_stencils(cs);
-  const std::vector<std::vector<T>> grid_a = check_p2g(cs);
-  check_p2g_interleaved(cs, grid_a);
-  check_p2g_impulse(cs, grid_a);
-  check_stress(cs);
-  check_p2g_faces(cs);
-  check_p2g_outside_grid(cs);
-  check_force_differential(cs);
-  check_pressure(cs);
-  check_g2p(cs);
+  cs.check_stencils();
+  const std::vector<std::vector<T>> grid_a = cs.check_p2g();
+  cs.check_p2g_interleaved(grid_a);
+  cs.check_p2g_impulse(grid_a);
+  cs.check_stress();
+  cs.check_p2g_faces();
+  cs.check_p2g_outside_grid();
+  cs.check_force_differential();
+  cs.check_pressure();
+  cs.check_g2p();
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // One case of the test (scalar T, dimension D, with or without the pressure solve): its sizes
 // and tolerances, the material, the particles, and the host's collocated box, shared by the
-// checks. Each check function binds the fields it uses to local names (ck, kernel, h, soa, ...).
+// checks. The checks are member functions of the case, so that they see its fields by name (ck,
+// kernel, h, soa, ...); they are declared here and defined in checks_*.hpp.
 #pragma once
 
 #include "host.hpp"
@@ -10,8 +11,15 @@ namespace {
 constexpr std::uint64_t kSeed = 0x5eed'a3b1'2014'0004ULL;
 
 template <class T, int D>
+struct G2pNodes;
+
+template <class T, int D>
 struct Case {
   using A = PartApi<T, D>;
+  using Ch = typename A::Channel;
+  using CCh = typename A::ConstChannel;
+  using Vec = Eigen::Matrix<ld, D, 1>;
+  using Grids = std::vector<std::vector<T>>;  // per-channel node arrays
 
   Checker& ck;
   const ld eps = std::numeric_limits<T>::epsilon();
@@ -75,6 +83,29 @@ struct Case {
                "%s %s %zu: got %.12Le want %.12Le (tol %.3Le)", A::name, what, i, got, want,
                c * eps * scale);
   }
+
+  // The checks, in the order run() calls them. checks_stencil.hpp:
+  void check_stencils() const;
+  // checks_p2g.hpp:
+  Grids check_p2g() const;
+  void check_p2g_interleaved(const Grids& grid_a) const;
+  void check_p2g_impulse(const Grids& grid_a) const;
+  void check_stress() const;
+  void check_p2g_faces() const;
+  void check_p2g_outside_grid() const;
+  // checks_force.hpp:
+  void check_force_differential();
+  void check_force_apply(const Grids& du, bool psd);
+  void check_nsd_particles(const std::vector<T>& slots);
+  void check_unprepared_slots(const Grids& du) const;
+  // checks_pressure.hpp:
+  void check_pressure() const;
+  // checks_g2p.hpp:
+  void check_g2p();
+  void check_g2p_update(const G2pNodes<T, D>& nodes, const Soa<T, D>& before, bool mac);
+  void check_g2p_failed_particles(const G2pNodes<T, D>& nodes, const Soa<T, D>& before) const;
+  void check_g2p_non_finite_node(const G2pNodes<T, D>& nodes, const Soa<T, D>& before) const;
+  void check_g2p_call_errors(const G2pNodes<T, D>& nodes, const Soa<T, D>& before) const;
 };
 
 }  // namespace

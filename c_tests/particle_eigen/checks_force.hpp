@@ -7,23 +7,24 @@
 
 namespace {
 
+/// The force view of `box` reading du from `du` and summing df into `df`.
+template <class T, int D>
+typename PartApi<T, D>::ForceView force_view(const std::vector<std::vector<T>>& du,
+                                             std::vector<std::vector<T>>& df, const Box<D>& box) {
+  using A = PartApi<T, D>;
+  typename A::ForceView fv{};
+  fv.nodes = box.c();
+  for (int a = 0; a < D; ++a) {
+    fv.du[a] = channel<typename A::ConstChannel>(du[a].data(), box);
+    fv.df[a] = channel<typename A::Channel>(df[a].data(), box);
+  }
+  return fv;
+}
+
 /// Per particle (one-particle applies), random du on its stencil: du·df = G:M(G) ≤ 0
 /// with the projection, to 256·ε of V⁰(μ + λ)·4·g_abs², g_abs = Σ_j |du_j||∇w_j|.
 template <class T, int D>
-void check_nsd_particles(Case<T, D>& cs, const std::vector<T>& slots) {
-  using A = PartApi<T, D>;
-  using Vec = Eigen::Matrix<ld, D, 1>;
-  using Ch = typename A::Channel;
-  using CCh = typename A::ConstChannel;
-  Checker& ck = cs.ck;
-  Rng& rng = cs.rng;
-  const RefMaterial& mat = cs.mat;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const ld eps = cs.eps;
-  const Soa<T, D>& soa = cs.soa;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_nsd_particles(const std::vector<T>& slots) {
   const std::size_t sl = A::slot_len;
   for (std::size_t i = 0; i < n; ++i) {
     const RefParticle<D> p = soa.get(i);
@@ -39,12 +40,7 @@ void check_nsd_particles(Case<T, D>& cs, const std::vector<T>& slots) {
         for (int a = 0; a < D; ++a) uu(a) = u[a][k];
         gabs += uu.norm() * s.grad[r].norm();
       }
-      typename A::ForceView one{};
-      one.nodes = box.c();
-      for (int a = 0; a < D; ++a) {
-        one.du[a] = channel<CCh>(static_cast<const T*>(u[a].data()), box);
-        one.df[a] = channel<Ch>(f[a].data(), box);
-      }
+      typename A::ForceView one = force_view(u, f, box);
       std::size_t f1 = 999;
       AMPM_CHECK_STATUS(ck, (A::apply(kernel, h, 1, soa.x.data() + D * i,
                                       slots.data() + sl * i, &one, &f1)),
@@ -63,21 +59,7 @@ void check_nsd_particles(Case<T, D>& cs, const std::vector<T>& slots) {
 /// Prepare (exact, or with AMPM_MODEL_PSD_HESSIAN when `psd`) and apply(du) against the
 /// reference node sums; with the projection, then check_nsd_particles.
 template <class T, int D>
-void check_force_apply(Case<T, D>& cs, const std::vector<std::vector<T>>& du, bool psd) {
-  using A = PartApi<T, D>;
-  using Vec = Eigen::Matrix<ld, D, 1>;
-  using Ch = typename A::Channel;
-  using CCh = typename A::ConstChannel;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const ld Sn = cs.Sn;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_force_apply(const Grids& du, bool psd) {
   const std::size_t sl = A::slot_len;
   auto cmat = cm;
   if (psd) cmat.model |= AMPM_MODEL_PSD_HESSIAN;
@@ -86,12 +68,7 @@ void check_force_apply(Case<T, D>& cs, const std::vector<std::vector<T>>& du, bo
   AMPM_CHECK_STATUS(ck, (A::prepare(&cmat, n, &ps, slots.data(), &first)), AMPM_OK);
   AMPM_CHECK(ck, first == n, "%s prepare: first_failed = %zu", A::name, first);
   std::vector<std::vector<T>> df(D, std::vector<T>(nn, 0));
-  typename A::ForceView fv{};
-  fv.nodes = box.c();
-  for (int a = 0; a < D; ++a) {
-    fv.du[a] = channel<CCh>(static_cast<const T*>(du[a].data()), box);
-    fv.df[a] = channel<Ch>(df[a].data(), box);
-  }
+  typename A::ForceView fv = force_view(du, df, box);
   first = 999;
   AMPM_CHECK_STATUS(ck, (A::apply(kernel, h, n, soa.x.data(), slots.data(), &fv, &first)),
                     AMPM_OK);
@@ -121,35 +98,20 @@ void check_force_apply(Case<T, D>& cs, const std::vector<std::vector<T>>& du, bo
   }
   for (int a = 0; a < D; ++a)
     for (std::size_t k = 0; k < nn; ++k)
-      cs.close(psd ? "force differential (NSD)" : "force differential", k, df[a][k],
+      close(psd ? "force differential (NSD)" : "force differential", k, df[a][k],
                ref[a].sum[k], ref[a].scale[k], Sn);
 
-  if (psd) check_nsd_particles(cs, slots);
+  if (psd) check_nsd_particles(slots);
 }
 
 /// Slots that no successful prepare wrote: zero-filled memory, and the slot of a particle
 /// whose prepare failed, are refused with AMPM_ERR_NOT_PREPARED; the other particles apply.
 template <class T, int D>
-void check_unprepared_slots(const Case<T, D>& cs, const std::vector<std::vector<T>>& du) {
-  using A = PartApi<T, D>;
-  using Ch = typename A::Channel;
-  using CCh = typename A::ConstChannel;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const Soa<T, D>& soa = cs.soa;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_unprepared_slots(const Grids& du) const {
   const std::size_t sl = A::slot_len;
   std::vector<T> slots(n * sl, T(0));
   std::vector<std::vector<T>> df(D, std::vector<T>(nn, 0));
-  typename A::ForceView fv{};
-  fv.nodes = box.c();
-  for (int a = 0; a < D; ++a) {
-    fv.du[a] = channel<CCh>(static_cast<const T*>(du[a].data()), box);
-    fv.df[a] = channel<Ch>(df[a].data(), box);
-  }
+  typename A::ForceView fv = force_view(du, df, box);
   std::size_t first = 999;
   AMPM_CHECK_STATUS(ck, (A::apply(kernel, h, n, soa.x.data(), slots.data(), &fv, &first)),
                     AMPM_ERR_NOT_PREPARED);
@@ -175,14 +137,12 @@ void check_unprepared_slots(const Case<T, D>& cs, const std::vector<std::vector<
 /// prepare, exact Hessian and the NSD projection, against the reference node sums
 /// Σ_p M_p(G_p) ∇w_ip.
 template <class T, int D>
-void check_force_differential(Case<T, D>& cs) {
-  Rng& rng = cs.rng;
-  const std::size_t nn = cs.nn;
+void Case<T, D>::check_force_differential() {
   std::vector<std::vector<T>> du(D, std::vector<T>(nn));
   for (auto& c : du)
     for (auto& x : c) x = static_cast<T>(rng.uniform(-1e-3, 1e-3));
-  for (const bool psd : {false, true}) check_force_apply(cs, du, psd);
-  check_unprepared_slots(cs, du);
+  for (const bool psd : {false, true}) check_force_apply(du, psd);
+  check_unprepared_slots(du);
 }
 
 }  // namespace

@@ -100,19 +100,8 @@ struct G2pNodes {
 /// G2P and the particle update (collocated, or MAC when `mac`) from `before` against the
 /// reference update.
 template <class T, int D>
-void check_g2p_update(Case<T, D>& cs, const G2pNodes<T, D>& nodes, const Soa<T, D>& before,
-                      bool mac) {
-  using A = PartApi<T, D>;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h, dt = cs.dt;
-  const std::size_t n = cs.n;
-  const ld C = cs.C;
-  Soa<T, D>& soa = cs.soa;
-  auto& ps = cs.ps;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_g2p_update(const G2pNodes<T, D>& nodes, const Soa<T, D>& before,
+                                  bool mac) {
   const auto& vel = nodes.vel;
   const auto& tn = nodes.tn;
   const auto& to = nodes.to;
@@ -158,12 +147,12 @@ void check_g2p_update(Case<T, D>& cs, const G2pNodes<T, D>& nodes, const Soa<T, 
                what, i, got.phase, want.phase);
     const ld vs = 1 + (i == n - 1 ? 3 / dt * 4 : 0);
     for (int a = 0; a < D; ++a) {
-      cs.close("v", i, got.v(a), want.v(a), vs, C);
-      cs.close("x", i, got.x(a), want.x(a), 6 + dt * vs, C);
+      close("v", i, got.v(a), want.v(a), vs, C);
+      close("x", i, got.x(a), want.x(a), 6 + dt * vs, C);
     }
-    cs.close("affine", i, (got.c - want.c).norm(), 0, vs / h, C);
-    cs.close("F_E", i, (got.fe - want.fe).norm(), 0, 1, C);
-    cs.close("F_P", i, (got.fp - want.fp).norm(), 0, 1, C);
+    close("affine", i, (got.c - want.c).norm(), 0, vs / h, C);
+    close("F_E", i, (got.fe - want.fe).norm(), 0, 1, C);
+    close("F_P", i, (got.fp - want.fp).norm(), 0, 1, C);
     AMPM_CHECK(ck, got.fe.determinant() > 0 && got.fp.determinant() > 0,
                "%s %s particle %zu: J_E or J_P <= 0", A::name, what, i);
     if (got.phase == 1) {
@@ -171,8 +160,8 @@ void check_g2p_update(Case<T, D>& cs, const G2pNodes<T, D>& nodes, const Soa<T, 
       AMPM_CHECK(ck, off.norm() == 0, "%s %s liquid particle %zu: F_P not a multiple of I",
                  A::name, what, i);
     }
-    cs.close("temperature", i, got.t, want.t, 300, C);
-    cs.close("latent", i, got.u, want.u, 100, C);
+    close("temperature", i, got.t, want.t, 300, C);
+    close("latent", i, got.u, want.u, 100, C);
     // J = J_E J_P changes by det(I + Δt∇v) only: away from the remedy ≈ 1 + O(Δt|∇v|).
     const ld j_in = in.fe.determinant() * in.fp.determinant();
     const ld j_out = got.fe.determinant() * got.fp.determinant();
@@ -182,20 +171,14 @@ void check_g2p_update(Case<T, D>& cs, const G2pNodes<T, D>& nodes, const Soa<T, 
   }
   // The remedy's particle: k = 1 gives det = (1 − 3/2)² = 1/4.
   const RefParticle<D> in = before.get(n - 1), got = soa.get(n - 1);
-  cs.close("remedy J_E ratio", n - 1, got.fe.determinant() / in.fe.determinant(), 0.25L, 1,
+  close("remedy J_E ratio", n - 1, got.fe.determinant() / in.fe.determinant(), 0.25L, 1,
            4 * C);
 }
 
 /// Batch contract: a failed particle is left as it was, the others are computed.
 template <class T, int D>
-void check_g2p_failed_particles(const Case<T, D>& cs, const G2pNodes<T, D>& nodes,
-                                const Soa<T, D>& before) {
-  using A = PartApi<T, D>;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel;
-  const T h = cs.h, dt = cs.dt;
-  const std::size_t n = cs.n;
+void Case<T, D>::check_g2p_failed_particles(const G2pNodes<T, D>& nodes,
+                                            const Soa<T, D>& before) const {
   const auto& gv = nodes.gv;
   Soa<T, D> bad = before;
   bad.fe[D * D * 3] = std::numeric_limits<T>::quiet_NaN();
@@ -217,16 +200,8 @@ void check_g2p_failed_particles(const Case<T, D>& cs, const G2pNodes<T, D>& node
 
 /// A non-finite node value inside a stencil fails that particle only.
 template <class T, int D>
-void check_g2p_non_finite_node(const Case<T, D>& cs, const G2pNodes<T, D>& nodes,
-                               const Soa<T, D>& before) {
-  using A = PartApi<T, D>;
-  using CCh = typename A::ConstChannel;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h, dt = cs.dt;
-  const std::size_t n = cs.n;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_g2p_non_finite_node(const G2pNodes<T, D>& nodes,
+                                           const Soa<T, D>& before) const {
   const auto& vel = nodes.vel;
   const auto& gv = nodes.gv;
   Soa<T, D> s2 = before;
@@ -246,14 +221,8 @@ void check_g2p_non_finite_node(const Case<T, D>& cs, const G2pNodes<T, D>& nodes
 
 /// Whole-call errors and n = 0.
 template <class T, int D>
-void check_g2p_call_errors(const Case<T, D>& cs, const G2pNodes<T, D>& nodes,
-                           const Soa<T, D>& before) {
-  using A = PartApi<T, D>;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel;
-  const T h = cs.h, dt = cs.dt;
-  const std::size_t n = cs.n;
+void Case<T, D>::check_g2p_call_errors(const G2pNodes<T, D>& nodes,
+                                       const Soa<T, D>& before) const {
   const auto& gv = nodes.gv;
   typename A::Particles nul{};
   std::size_t first = 999;
@@ -275,13 +244,13 @@ void check_g2p_call_errors(const Case<T, D>& cs, const G2pNodes<T, D>& nodes,
 
 /// G2P and the particle update: the grid (G2pNodes), then the checks above in order.
 template <class T, int D>
-void check_g2p(Case<T, D>& cs) {
-  const G2pNodes<T, D> nodes(cs);
-  const Soa<T, D> before = cs.soa;
-  for (const bool mac : {false, true}) check_g2p_update(cs, nodes, before, mac);
-  check_g2p_failed_particles(cs, nodes, before);
-  check_g2p_non_finite_node(cs, nodes, before);
-  check_g2p_call_errors(cs, nodes, before);
+void Case<T, D>::check_g2p() {
+  const G2pNodes<T, D> nodes(*this);
+  const Soa<T, D> before = soa;
+  for (const bool mac : {false, true}) check_g2p_update(nodes, before, mac);
+  check_g2p_failed_particles(nodes, before);
+  check_g2p_non_finite_node(nodes, before);
+  check_g2p_call_errors(nodes, before);
 }
 
 }  // namespace

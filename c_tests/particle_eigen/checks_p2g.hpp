@@ -12,35 +12,30 @@ namespace {
 template <int D>
 constexpr int kNch = 1 + 2 * D + 3;
 
+/// The P2G view of `box` with every channel (kNch) over the arrays `grid` of that layout.
+template <class T, int D>
+typename PartApi<T, D>::P2gView p2g_view(std::vector<std::vector<T>>& grid, const Box<D>& box) {
+  using Ch = typename PartApi<T, D>::Channel;
+  typename PartApi<T, D>::P2gView view{};
+  view.nodes = box.c();
+  view.mass = channel<Ch>(grid[0].data(), box);
+  for (int a = 0; a < D; ++a) {
+    view.momentum[a] = channel<Ch>(grid[1 + a].data(), box);
+    view.force[a] = channel<Ch>(grid[1 + D + a].data(), box);
+  }
+  view.heat_capacity = channel<Ch>(grid[2 * D + 1].data(), box);
+  view.thermal_energy = channel<Ch>(grid[2 * D + 2].data(), box);
+  view.conductivity = channel<Ch>(grid[2 * D + 3].data(), box);
+  return view;
+}
+
 /// P2G on the collocated grid, every channel (kNch), against the reference node sums.
 /// Returns the node arrays of the channels (the reference of the checks below).
 template <class T, int D>
-std::vector<std::vector<T>> check_p2g(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  using Vec = Eigen::Matrix<ld, D, 1>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const ld Cn = cs.Cn, Sn = cs.Sn;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
-  const Box<D>& box = cs.box;
+std::vector<std::vector<T>> Case<T, D>::check_p2g() const {
   const int NCH = kNch<D>;
   std::vector<std::vector<T>> grid_a(NCH, std::vector<T>(nn, 0));
-  typename A::P2gView view{};
-  view.nodes = box.c();
-  view.mass = channel<Ch>(grid_a[0].data(), box);
-  for (int a = 0; a < D; ++a) {
-    view.momentum[a] = channel<Ch>(grid_a[1 + a].data(), box);
-    view.force[a] = channel<Ch>(grid_a[1 + D + a].data(), box);
-  }
-  view.heat_capacity = channel<Ch>(grid_a[2 * D + 1].data(), box);
-  view.thermal_energy = channel<Ch>(grid_a[2 * D + 2].data(), box);
-  view.conductivity = channel<Ch>(grid_a[2 * D + 3].data(), box);
+  typename A::P2gView view = p2g_view(grid_a, box);
   std::size_t first = 999;
   AMPM_CHECK_STATUS(ck, (A::p2g(&cm, kernel, AMPM_GRID_COLLOCATED, h, T(0), n, &ps, &view,
                                 &first)),
@@ -80,7 +75,7 @@ std::vector<std::vector<T>> check_p2g(const Case<T, D>& cs) {
   for (int ch = 0; ch < NCH; ++ch) {
     const int nm = ch == 0 ? 0 : ch <= D ? 1 : ch <= 2 * D ? 4 : 7 + (ch - 2 * D - 1);
     for (std::size_t k = 0; k < nn; ++k)
-      cs.close(names[nm], k, grid_a[ch][k], ref[ch].sum[k], ref[ch].scale[k], cst[ch]);
+      close(names[nm], k, grid_a[ch][k], ref[ch].sum[k], ref[ch].scale[k], cst[ch]);
   }
   return grid_a;
 }
@@ -88,16 +83,7 @@ std::vector<std::vector<T>> check_p2g(const Case<T, D>& cs) {
 /// The same P2G through an interleaved node struct of NCH scalars, axis D−1 fastest and axis
 /// 0 reversed (negative stride): the same sums in the same order, so bit for bit the same.
 template <class T, int D>
-void check_p2g_interleaved(const Case<T, D>& cs, const std::vector<std::vector<T>>& grid_a) {
-  using A = PartApi<T, D>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const auto& ps = cs.ps;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_p2g_interleaved(const Grids& grid_a) const {
   const int NCH = kNch<D>;
   std::vector<std::ptrdiff_t> st(D);
   st[D - 1] = NCH;
@@ -136,19 +122,7 @@ void check_p2g_interleaved(const Case<T, D>& cs, const std::vector<std::vector<T
 /// impulse_dt = Δt without a force channel: momentum + Δt·force of the plain form (each
 /// contribution rounds once more, so the node sums agree to (C + n)·ε of the magnitudes).
 template <class T, int D>
-void check_p2g_impulse(const Case<T, D>& cs, const std::vector<std::vector<T>>& grid_a) {
-  using A = PartApi<T, D>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n, nn = cs.nn;
-  const ld Sn = cs.Sn;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
-  const Box<D>& box = cs.box;
+void Case<T, D>::check_p2g_impulse(const Grids& grid_a) const {
   const T idt = static_cast<T>(0.01);
   std::vector<T> m(nn, 0);
   std::vector<std::vector<T>> mom(D, std::vector<T>(nn, 0));
@@ -174,7 +148,7 @@ void check_p2g_impulse(const Case<T, D>& cs, const std::vector<std::vector<T>>& 
     AMPM_CHECK(ck, same_bits(&m[k], &grid_a[0][k], 1), "%s impulse p2g: mass differs",
                A::name);
     for (int a = 0; a < D; ++a)
-      cs.close("impulse momentum", k, mom[a][k],
+      close("impulse momentum", k, mom[a][k],
                static_cast<ld>(grid_a[1 + a][k]) + static_cast<ld>(idt) * grid_a[1 + D + a][k],
                sc[k], Sn);
   }
@@ -185,19 +159,7 @@ void check_p2g_impulse(const Case<T, D>& cs, const std::vector<std::vector<T>>& 
 /// liquid's is isotropic. The sum has K^d terms of size ≤ V⁰‖τ‖·|∇w||x_i − x_p| ≤
 /// V⁰‖τ‖·2√d, hence 256·K^d·2√d.
 template <class T, int D>
-void check_stress(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  using Vec = Eigen::Matrix<ld, D, 1>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n;
-  const ld eps = cs.eps;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
+void Case<T, D>::check_stress() const {
   for (std::size_t i = 0; i < n; ++i) {
     const RefParticle<D> p = soa.get(i);
     const RefStencil<D> s = ref_stencil<D>(kernel, -1, h, p.x);
@@ -225,7 +187,7 @@ void check_stress(const Case<T, D>& cs) {
     const auto [mu, il] = moduli(mat, p);
     const ld ts = tau.norm() + mu + 1 / il;
     const ld c_tau = 256 * K * 2 * std::sqrt(ld(D));
-    cs.close("stress from one-particle p2g", i, (tau_lib - tau).norm(), 0, ts, c_tau);
+    close("stress from one-particle p2g", i, (tau_lib - tau).norm(), 0, ts, c_tau);
     if (p.phase == 1) {
       const MatL<D> dev = tau_lib - tau_lib.trace() / D * MatL<D>::Identity();
       AMPM_CHECK(ck, dev.norm() <= c_tau * eps * ts, "%s liquid deviatoric stress %.3Le",
@@ -237,34 +199,14 @@ void check_stress(const Case<T, D>& cs) {
 /// P2G on each MAC face grid a: mass, momentum[a] and force[a] with the face stencil; the
 /// other channels of the view stay untouched.
 template <class T, int D>
-void check_p2g_faces(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n;
-  const ld Cn = cs.Cn, Sn = cs.Sn;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
+void Case<T, D>::check_p2g_faces() const {
   const int NCH = kNch<D>;
   for (int g = 0; g < D; ++g) {
     Box<D> fb = ref_box<T, D>(soa, n, kernel, g, h);
     for (int a = 0; a < D; ++a) fb.lo[a] -= 1, fb.dims[a] += 2;
     const std::size_t fn = fb.count();
     std::vector<std::vector<T>> fg(NCH, std::vector<T>(fn, 0));
-    typename A::P2gView view{};
-    view.nodes = fb.c();
-    view.mass = channel<Ch>(fg[0].data(), fb);
-    for (int a = 0; a < D; ++a) {
-      view.momentum[a] = channel<Ch>(fg[1 + a].data(), fb);
-      view.force[a] = channel<Ch>(fg[1 + D + a].data(), fb);
-    }
-    view.heat_capacity = channel<Ch>(fg[2 * D + 1].data(), fb);
-    view.thermal_energy = channel<Ch>(fg[2 * D + 2].data(), fb);
-    view.conductivity = channel<Ch>(fg[2 * D + 3].data(), fb);
+    typename A::P2gView view = p2g_view(fg, fb);
     std::size_t first = 999;
     AMPM_CHECK_STATUS(ck, (A::p2g(&cm, kernel, g, h, T(0), n, &ps, &view, &first)), AMPM_OK);
     RefField rm(fn), rq(fn), rf(fn);
@@ -283,9 +225,9 @@ void check_p2g_faces(const Case<T, D>& cs) {
     }
     bool untouched = true;
     for (std::size_t k = 0; k < fn; ++k) {
-      cs.close("face mass", k, fg[0][k], rm.sum[k], rm.scale[k], Cn);
-      cs.close("face momentum", k, fg[1 + g][k], rq.sum[k], rq.scale[k], Cn);
-      cs.close("face force", k, fg[1 + D + g][k], rf.sum[k], rf.scale[k], Sn);
+      close("face mass", k, fg[0][k], rm.sum[k], rm.scale[k], Cn);
+      close("face momentum", k, fg[1 + g][k], rq.sum[k], rq.scale[k], Cn);
+      close("face force", k, fg[1 + D + g][k], rf.sum[k], rf.scale[k], Sn);
       for (int ch = 1; ch < NCH; ++ch)
         if (ch != 1 + g && ch != 1 + D + g) untouched &= fg[ch][k] == T(0);
     }
@@ -299,16 +241,7 @@ void check_p2g_faces(const Case<T, D>& cs) {
 /// only them, in the same order (node sums are formed per run of nearby particles, and a
 /// failed particle does not change the runs).
 template <class T, int D>
-void check_p2g_outside_grid(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  using Ch = typename A::Channel;
-  Checker& ck = cs.ck;
-  const auto& cm = cs.cm;
-  const int kernel = cs.kernel;
-  const T h = cs.h;
-  const std::size_t n = cs.n;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
+void Case<T, D>::check_p2g_outside_grid() const {
   Box<D> sb = ref_box<T, D>(soa, n, kernel, -1, h);
   const int last = sb.lo[0] + sb.dims[0] - 1;
   sb.dims[0] -= 1;

@@ -8,16 +8,7 @@ namespace {
 
 /// Pressure and coefficient of every particle against the reference.
 template <class T, int D>
-void check_pressure(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  Checker& ck = cs.ck;
-  const RefMaterial& mat = cs.mat;
-  const auto& cm = cs.cm;
-  const T dt = cs.dt;
-  const std::size_t n = cs.n;
-  const ld C = cs.C;
-  const Soa<T, D>& soa = cs.soa;
-  const auto& ps = cs.ps;
+void Case<T, D>::check_pressure() const {
   std::vector<T> pr(n, sentinel<T>()), co(n, sentinel<T>());
   std::size_t first = 999;
   AMPM_CHECK_STATUS(ck, (A::pressure(&cm, dt, n, &ps, pr.data(), co.data(), &first)), AMPM_OK);
@@ -26,8 +17,8 @@ void check_pressure(const Case<T, D>& cs) {
     const auto [mu, il] = moduli(mat, p);
     (void)mu;
     const ld je = p.fe.determinant(), jp = p.fp.determinant();
-    cs.close("pressure", i, pr[i], -(je - 1) / (il * jp), 1 / il, C);
-    cs.close("coefficient", i, co[i], jp * il / (dt * je), il / dt, C);
+    close("pressure", i, pr[i], -(je - 1) / (il * jp), 1 / il, C);
+    close("coefficient", i, co[i], jp * il / (dt * je), il / dt, C);
   }
 }
 

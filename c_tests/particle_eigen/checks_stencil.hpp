@@ -8,14 +8,7 @@ namespace {
 
 /// Stencils on every grid: weights and gradients; node ranges.
 template <class T, int D>
-void check_stencils(const Case<T, D>& cs) {
-  using A = PartApi<T, D>;
-  Checker& ck = cs.ck;
-  const int kernel = cs.kernel, K = cs.K;
-  const T h = cs.h;
-  const std::size_t n = cs.n;
-  const ld C = cs.C;
-  const Soa<T, D>& soa = cs.soa;
+void Case<T, D>::check_stencils() const {
   for (int grid = -1; grid < D; ++grid) {
     std::vector<int> base(n * D);
     std::vector<T> w(n * K), gw(n * K * D);
@@ -30,9 +23,9 @@ void check_stencils(const Case<T, D>& cs) {
         AMPM_CHECK(ck, base[D * i + a] == s.base[a], "%s stencil base", A::name);
       for (int r = 0; r < K; ++r) {
         // x/h carries ε·|x/h| ≤ 12ε of rounding, amplified by |N'| ≤ 1 per axis.
-        cs.close("weight", i, w[K * i + r], s.w[r], 1 + 12 * D, C);
+        close("weight", i, w[K * i + r], s.w[r], 1 + 12 * D, C);
         for (int a = 0; a < D; ++a)
-          cs.close("grad weight", i, gw[(K * i + r) * D + a], s.grad[r](a), (1 + 12 * D) / h, C);
+          close("grad weight", i, gw[(K * i + r) * D + a], s.grad[r](a), (1 + 12 * D) / h, C);
       }
     }
     const Box<D> want = ref_box<T, D>(soa, n, kernel, grid, h);
