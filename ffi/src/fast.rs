@@ -26,9 +26,10 @@ fn code(k: IsaKind) -> u32 {
     KINDS.iter().position(|&x| x == k).unwrap_or(0) as u32
 }
 
-/// `1 + AMPM_ISA_*` in bits 0–1, [`Isa::joined_rows`] in bit 2 (never 0).
+/// `1 + AMPM_ISA_*` in bits 0–1, [`Isa::joined_rows`] in bit 2, [`Isa::narrow_chunks`] in
+/// bit 3 (never 0).
 fn encode(i: Isa) -> u8 {
-    (code(i.kind()) as u8 + 1) | u8::from(i.joined_rows()) << 2
+    (code(i.kind()) as u8 + 1) | u8::from(i.joined_rows()) << 2 | u8::from(i.narrow_chunks()) << 3
 }
 
 /// The [`Isa`] of a non-zero [`encode`] value.
@@ -36,7 +37,9 @@ fn decode(c: u8) -> Isa {
     let kind = KINDS[usize::from(c & 3).saturating_sub(1)];
     // SAFETY: every value stored in `ISA` encodes an `Isa` that `Isa::available` returned, so
     // the CPU supports its instructions.
-    unsafe { Isa::assume(kind) }.with_joined_rows(c & 4 != 0)
+    unsafe { Isa::assume(kind) }
+        .with_joined_rows(c & 4 != 0)
+        .with_narrow_chunks(c & 8 != 0)
 }
 
 /// The instruction set the batch calls use: the widest this CPU supports, detected on first
@@ -228,16 +231,18 @@ where
 mod tests {
     use super::*;
 
-    /// Every instruction set of this CPU survives the stored form with its joined-rows flag,
-    /// both values of the flag round-trip, and `set_isa` then `isa` gives back what
+    /// Every instruction set of this CPU survives the stored form with its joined-rows and
+    /// narrow-chunks flags, every value of the flags round-trips, and `set_isa` then `isa` gives back what
     /// `Isa::available` listed (the choice is restored afterwards).
     #[test]
     fn stored_isa_round_trips() {
         for i in Isa::available() {
             assert_eq!(decode(encode(i)), i);
-            for on in [false, true] {
-                let j = i.with_joined_rows(on);
-                assert_eq!(decode(encode(j)), j);
+            for joined in [false, true] {
+                for narrow in [false, true] {
+                    let j = i.with_joined_rows(joined).with_narrow_chunks(narrow);
+                    assert_eq!(decode(encode(j)), j);
+                }
             }
         }
         let before = isa();

@@ -233,14 +233,18 @@ impl<T: Real> Store<T> {
     }
 }
 
-/// Every instruction set of this CPU, AVX-512 both with and without joined rows
-/// (`Isa::joined_rows`: two eight-lane node rows in one register), so that both forms are
-/// tested on any AVX-512 machine whichever is its default.
+/// Every instruction set of this CPU, AVX-512 in each of its forms (`Isa::joined_rows`: two
+/// eight-lane node rows in one register; `Isa::narrow_chunks`: P2G's `f32` chunks of two
+/// vectors), so that every form is tested on any AVX-512 machine whichever is its default.
 fn isas() -> Vec<Isa> {
     Isa::available()
         .into_iter()
         .flat_map(|i| match i.kind() {
-            IsaKind::Avx512 => vec![i.with_joined_rows(false), i.with_joined_rows(true)],
+            IsaKind::Avx512 => vec![
+                i.with_joined_rows(false).with_narrow_chunks(false),
+                i.with_joined_rows(true).with_narrow_chunks(false),
+                i.with_joined_rows(false).with_narrow_chunks(true),
+            ],
             _ => vec![i],
         })
         .collect()

@@ -4,7 +4,8 @@
 //! and `tools/benches/particle_levels.rs`). Environment: `AMPM_TT_REPS` (runs, best kept),
 //! `AMPM_TT_ISA` (`avx2`, `avx512`, ...: that instruction set only), `AMPM_TT_SIDE` (particles
 //! per axis), `AMPM_TT_PAD` (more grid nodes per axis), `AMPM_TT_JOINED` (`0` or `1`: AVX-512
-//! without or with joined rows, `Isa::joined_rows`; default the CPU's).
+//! without or with joined rows, `Isa::joined_rows`; default the CPU's), `AMPM_TT_NARROW` (`0`
+//! or `1`: AVX-512 P2G on four or two vectors, `Isa::narrow_chunks`; default the CPU's).
 use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
 use ampm_core::particle::transfer::force::{self, ForceView};
@@ -200,6 +201,11 @@ where
             Ok("1") => isa.with_joined_rows(true),
             _ => isa,
         };
+        let isa = match std::env::var("AMPM_TT_NARROW").as_deref() {
+            Ok("0") => isa.with_narrow_chunks(false),
+            Ok("1") => isa.with_narrow_chunks(true),
+            _ => isa,
+        };
         let args = P2gArgs {
             kernel: Kernel::Quadratic,
             grid: Grid::Collocated,
@@ -298,7 +304,11 @@ where
             "{level}{} {}{}: p2g {:.1} ns, g2p {:.1} ns, apply {:.1} ns per particle (best of {reps})",
             if D == 2 { " 2d" } else { "" },
             isa.name(),
-            if isa.joined_rows() { " joined" } else { "" },
+            match (isa.joined_rows(), isa.narrow_chunks()) {
+                (true, _) => " joined",
+                (false, true) => " narrow",
+                _ => "",
+            },
             best.0 / n as f64 * 1e9,
             best.1 / n as f64 * 1e9,
             best.2 / n as f64 * 1e9

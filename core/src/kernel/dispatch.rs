@@ -1,7 +1,7 @@
 //! Running a chunk loop on an instruction set: the loop is generic over its lane types
 //! ([`LaneOp`]) and `#[inline(always)]` down to the intrinsics; [`dispatch`] instantiates it
 //! inside a `#[target_feature]` function per instruction set (AVX2, AVX-512 with or without
-//! VL and joined rows) and calls the one an [`Isa`] names. The scalars with SIMD paths
+//! VL, joined rows and narrow chunks) and calls the one an [`Isa`] names. The scalars with SIMD paths
 //! ([`BatchReal`]) name their lane types per instruction set, and [`BatchStatus`] is the
 //! outcome every batch call reports.
 
@@ -19,7 +19,8 @@ pub const MAX_LANES: usize = 32;
 pub const WIDE_LANES: usize = 2 * MAX_LANES;
 
 /// A particle loop generic over its chunk: the lane type `W` and a bound `L ≥ W::LANES` that
-/// sizes its buffers (`[T; L]`), run by [`BatchReal::with_chunks`].
+/// sizes its buffers (`[T; L]`), run by [`BatchReal::with_chunks`] or
+/// [`BatchReal::with_narrow_chunks`].
 pub trait WithChunks<T> {
     /// The result.
     type Out;
@@ -55,11 +56,24 @@ pub trait BatchReal: Real + sealed::Sealed {
     /// its AVX-512 P2G measured slower, liquid 134 ns instead of 123, and its buffers would
     /// need the stack twice).
     fn with_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out;
+
+    /// Whether [`Self::with_narrow_chunks`] differs from [`Self::with_chunks`] (`f32`).
+    const NARROW_DIFFERS: bool;
+
+    /// Runs `f` as [`Self::with_chunks`] but `f32` on `V` itself, two vectors on AVX-512
+    /// instead of four ([`Isa::narrow_chunks`]: on AMD Zen 4, whose 512-bit operations take
+    /// two 256-bit passes, two vectors already fill the pipes); `f64` as in `with_chunks`.
+    fn with_narrow_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out;
 }
 impl BatchReal for f32 {
     #[inline(always)]
     fn with_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out {
         f.run::<V::Wide, WIDE_LANES>()
+    }
+    const NARROW_DIFFERS: bool = true;
+    #[inline(always)]
+    fn with_narrow_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out {
+        f.run::<V, MAX_LANES>()
     }
 }
 impl BatchReal for f64 {
@@ -67,6 +81,11 @@ impl BatchReal for f64 {
     fn with_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out {
         // Two `f64×8`, the widest `f64` lane type.
         f.run::<V, { MAX_LANES / 2 }>()
+    }
+    const NARROW_DIFFERS: bool = false;
+    #[inline(always)]
+    fn with_narrow_chunks<V: Lane<Scalar = Self>, F: WithChunks<Self>>(f: F) -> F::Out {
+        Self::with_chunks::<V, F>(f)
     }
 }
 
@@ -144,6 +163,19 @@ pub(crate) trait LaneOp<T> {
     #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     const JOINS_ROWS: bool = false;
 
+    /// Runs the loop as [`Self::run_pairs`] on narrower chunks where the loop has them
+    /// ([`Isa::narrow_chunks`]; `dispatch` calls it only when [`Self::NARROWS_CHUNKS`]).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    #[inline(always)]
+    fn run_narrow<V: Lane<Scalar = T>, R: Lane<Scalar = T>, Q: Pair<R>>(&mut self) -> BatchStatus {
+        self.run_pairs::<V, R, Q>()
+    }
+
+    /// Whether [`Self::run_narrow`] differs from [`Self::run_pairs`] (other loops are built
+    /// once).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
+    const NARROWS_CHUNKS: bool = false;
+
     /// Whether the AVX-512 build of the loop also enables AVX-512 VL, DQ and BW (which
     /// [`IsaKind::Avx512`] guarantees): eight-lane rows then have 32 registers and k-masked
     /// moves. On for P2G and the force differential (AMD Zen 4: the apply about 15 % faster);
@@ -182,6 +214,14 @@ unsafe fn run_avx512_vl_joined<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchS
     op.run_pairs::<T::Avx512, T::Avx512Row, T::Avx512Pair>()
 }
 
+/// [`run_avx512_vl`] with narrow chunks ([`Isa::narrow_chunks`]): a function of its own, as
+/// [`run_avx512_vl_joined`].
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512vl,avx512dq,avx512bw,avx2,fma")]
+unsafe fn run_avx512_vl_narrow<T: BatchReal, O: LaneOp<T>>(op: &mut O) -> BatchStatus {
+    op.run_narrow::<T::Avx512, T::Avx512Row, X2<T::Avx512Row>>()
+}
+
 /// Runs `op` on the lanes of `isa`.
 #[inline]
 pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> BatchStatus {
@@ -195,6 +235,11 @@ pub(crate) fn dispatch<T: BatchReal, O: LaneOp<T>>(isa: Isa, op: &mut O) -> Batc
         IsaKind::Avx512 if O::AVX512_VL && O::JOINS_ROWS && isa.joined_rows() => unsafe {
             run_avx512_vl_joined::<T, O>(op)
         },
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: as above.
+        IsaKind::Avx512
+            if O::AVX512_VL && O::NARROWS_CHUNKS && T::NARROW_DIFFERS && isa.narrow_chunks() =>
+        unsafe { run_avx512_vl_narrow::<T, O>(op) },
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         IsaKind::Avx512 if O::AVX512_VL => unsafe { run_avx512_vl::<T, O>(op) },

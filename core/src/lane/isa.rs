@@ -1,17 +1,23 @@
 //! The instruction sets of the batch kernels ([`Isa`]): what the CPU supports, detected at
-//! run time, and whether the particle transfers join two eight-lane rows in one register.
+//! run time, and two per-CPU choices of the particle transfers' AVX-512 build: whether they
+//! join two eight-lane rows in one register, and how wide P2G's `f32` chunks are.
 
 /// The instruction sets of the batch kernels, widest first. A value other than
 /// [`Isa::SCALAR`] is a promise that the CPU supports it: create it with `Isa::detect` (with
 /// the `std` feature) or, unsafely, with [`Isa::assume`].
 ///
-/// With AVX-512 it also says whether the particle transfers put two eight-lane rows in one
-/// sixteen-lane register ([`Isa::joined_rows`]): on by default where 512-bit operations run at
-/// the full rate of two 256-bit ones without slowing the rest (AMD Zen 5 and later), off
-/// elsewhere (the joined rows measured 7–13% slower on an Intel Xeon, and P2G and apply 3–10%
-/// slower on AMD Zen 4, whose 512-bit operations take two 256-bit passes).
+/// With AVX-512 it also carries two choices of the particle transfers, both giving the same
+/// bits (but for the sign of a zero node sum with joined rows), set per CPU by `Isa::detect`:
+/// - [`Isa::joined_rows`], two eight-lane rows in one sixteen-lane register: on where 512-bit
+///   operations run at the full rate of two 256-bit ones without slowing the rest (AMD Zen 5
+///   and later), off elsewhere (the joined rows measured 7–13% slower on an Intel Xeon, and
+///   P2G and apply 3–10% slower on AMD Zen 4, whose 512-bit operations take two 256-bit
+///   passes);
+/// - [`Isa::narrow_chunks`], P2G's `f32` chunks of two sixteen-lane vectors instead of four:
+///   on for AMD Zen 4 (P2G + G2P 1–4% faster there), off elsewhere (four vectors measured
+///   6–7% faster on an Intel Xeon, and 0–1.4% faster on AMD Zen 5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Isa(IsaKind, bool);
+pub struct Isa(IsaKind, bool, bool);
 
 /// What an [`Isa`] names.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -28,7 +34,7 @@ pub enum IsaKind {
 
 impl Isa {
     /// The scalar path, available everywhere.
-    pub const SCALAR: Isa = Isa(IsaKind::Scalar, false);
+    pub const SCALAR: Isa = Isa(IsaKind::Scalar, false, false);
 
     /// What this value names.
     #[inline]
@@ -54,7 +60,7 @@ impl Isa {
     #[must_use]
     pub fn at_most_avx2(self) -> Isa {
         match self.0 {
-            IsaKind::Avx512 => Isa(IsaKind::Avx2, false),
+            IsaKind::Avx512 => Isa(IsaKind::Avx2, false, false),
             _ => self,
         }
     }
@@ -73,10 +79,28 @@ impl Isa {
     #[inline]
     #[must_use]
     pub fn with_joined_rows(self, on: bool) -> Isa {
-        Isa(self.0, on && self.0 == IsaKind::Avx512)
+        Isa(self.0, on && self.0 == IsaKind::Avx512, self.2)
     }
 
-    /// An [`Isa`] of the given kind without checking the CPU (rows not joined).
+    /// Whether P2G runs its `f32` chunks on two sixteen-lane vectors (32 lanes) instead of
+    /// four (64): AVX-512 without joined rows (joined rows keep four vectors). The same bits
+    /// either way: a particle's values do not depend on its chunk.
+    #[inline]
+    #[must_use]
+    pub fn narrow_chunks(self) -> bool {
+        self.2
+    }
+
+    /// This instruction set with narrow P2G chunks on or off ([`Isa::narrow_chunks`]; always
+    /// off for instruction sets other than AVX-512).
+    #[inline]
+    #[must_use]
+    pub fn with_narrow_chunks(self, on: bool) -> Isa {
+        Isa(self.0, self.1, on && self.0 == IsaKind::Avx512)
+    }
+
+    /// An [`Isa`] of the given kind without checking the CPU (rows not joined, chunks not
+    /// narrow).
     ///
     /// # Safety
     /// The CPU running every kernel called with the result must support the kind's
@@ -84,7 +108,7 @@ impl Isa {
     #[inline]
     #[must_use]
     pub const unsafe fn assume(kind: IsaKind) -> Isa {
-        Isa(kind, false)
+        Isa(kind, false, false)
     }
 
     /// The widest instruction set of this CPU (detected at run time). Detection runs `cpuid`,
@@ -104,13 +128,19 @@ impl Isa {
         #[cfg(target_arch = "x86_64")]
         {
             if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-                v.push(Isa(IsaKind::Avx2, false));
+                v.push(Isa(IsaKind::Avx2, false, false));
                 if std::is_x86_feature_detected!("avx512f")
                     && std::is_x86_feature_detected!("avx512vl")
                     && std::is_x86_feature_detected!("avx512dq")
                     && std::is_x86_feature_detected!("avx512bw")
                 {
-                    v.push(Isa(IsaKind::Avx512, full_rate_512()));
+                    let family = amd_family();
+                    // Zen 5 (1Ah) and later: joined rows; Zen 4 (19h): narrow chunks.
+                    v.push(Isa(
+                        IsaKind::Avx512,
+                        family >= Some(0x1a),
+                        family == Some(0x19),
+                    ));
                 }
             }
         }
@@ -118,11 +148,12 @@ impl Isa {
     }
 }
 
-/// Whether this CPU runs 512-bit vector operations at the rate of two 256-bit ones without
-/// slowing the rest: AMD family 1Ah (Zen 5) and later. Intel's server cores fuse two ports for
-/// 512-bit operations, and Zen 4 splits them into two 256-bit halves.
+/// The family of an AMD CPU (`cpuid` leaf 1, base plus extended family), `None` for other
+/// vendors. AMD family 1Ah (Zen 5) runs 512-bit vector operations at the rate of two 256-bit
+/// ones; family 19h (Zen 4) splits them into two 256-bit halves; Intel's server cores fuse two
+/// ports for them.
 #[cfg(all(feature = "std", target_arch = "x86_64"))]
-fn full_rate_512() -> bool {
+fn amd_family() -> Option<u32> {
     use core::arch::x86_64::__cpuid;
     let (v, f) = (__cpuid(0), __cpuid(1));
     let amd = (v.ebx, v.edx, v.ecx) == (0x6874_7541, 0x6974_6e65, 0x444d_4163);
@@ -132,5 +163,5 @@ fn full_rate_512() -> bool {
     } else {
         base
     };
-    amd && family >= 0x1a
+    amd.then_some(family)
 }

@@ -347,6 +347,13 @@ where
     fn run_pairs<V: Lane<Scalar = T>, R: Lane<Scalar = T>, Q: Pair<R>>(&mut self) -> BatchStatus {
         T::with_chunks::<V, _>(Chunks::<'_, '_, T, D, R, Q>(self, PhantomData))
     }
+
+    const NARROWS_CHUNKS: bool = true;
+
+    #[inline(always)]
+    fn run_narrow<V: Lane<Scalar = T>, R: Lane<Scalar = T>, Q: Pair<R>>(&mut self) -> BatchStatus {
+        T::with_narrow_chunks::<V, _>(Chunks::<'_, '_, T, D, R, Q>(self, PhantomData))
+    }
 }
 
 /// [`P2gOp`]'s particle loop with rows `R`, on the chunks [`BatchReal::with_chunks`] picks.
