@@ -11,6 +11,7 @@
 #include <cstdint>
 
 #include "ampm.hpp"
+#include "plain_check.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -20,18 +21,6 @@
 #include <vector>
 
 namespace {
-
-long g_checks = 0, g_failures = 0;
-#define CHECK(cond, ...)                                                   \
-  do {                                                                     \
-    ++g_checks;                                                            \
-    if (!(cond)) {                                                         \
-      ++g_failures;                                                        \
-      std::fprintf(stderr, "%s:%d: FAIL %s: ", __FILE__, __LINE__, #cond); \
-      std::fprintf(stderr, __VA_ARGS__);                                   \
-      std::fputc('\n', stderr);                                            \
-    }                                                                      \
-  } while (0)
 
 template <class S>
 bool bytes_eq(const S& a, const S& b) {

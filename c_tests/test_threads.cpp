@@ -18,6 +18,7 @@
 #include <cstdint>
 
 #include "ampm.hpp"
+#include "plain_check.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -27,18 +28,6 @@
 #include <vector>
 
 namespace {
-
-long g_checks = 0, g_failures = 0;
-#define CHECK(cond, ...)                                                   \
-  do {                                                                     \
-    ++g_checks;                                                            \
-    if (!(cond)) {                                                         \
-      ++g_failures;                                                        \
-      std::fprintf(stderr, "%s:%d: FAIL %s: ", __FILE__, __LINE__, #cond); \
-      std::fprintf(stderr, __VA_ARGS__);                                   \
-      std::fputc('\n', stderr);                                            \
-    }                                                                      \
-  } while (0)
 
 constexpr int kThreads = 4;
 constexpr int kCellsX = 8;    // cells per thread slab along x

@@ -8,6 +8,7 @@
 #include "ampm.h"
 #include "bench_machine.hpp"  // cpu_model, compiler, load_average
 #include "common.hpp"         // status_name, isa_name
+#include "dense_box.hpp"
 
 #include <Eigen/Dense>
 
@@ -239,30 +240,15 @@ Parts<T, D> make_parts(Scene scene, int per_axis) {
 // ---- the host's grid -----------------------------------------------------------------------
 
 template <class T, int D>
-struct Grid {
-  int lo[3] = {0, 0, 0}, dims[3] = {1, 1, 1};
-  std::size_t count = 1;
+struct Grid : ampm_test::DenseBox {
   std::vector<T> mass, hc, te, cond, tn, to;
   std::array<std::vector<T>, 3> mom, force, vel, mom2, du, df;
 
   void reset(const int* l, const int* h) {
-    count = 1;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = a < D ? l[a] : 0;
-      dims[a] = a < D ? h[a] - l[a] + 1 : 1;
-      count *= static_cast<std::size_t>(dims[a]);
-    }
+    set_box(D, l, h);
     for (auto* f : {&mass, &hc, &te, &cond, &tn, &to}) f->assign(count, 0);
     for (int a = 0; a < 3; ++a)
       for (auto* f : {&mom[a], &force[a], &vel[a], &mom2[a], &du[a], &df[a]}) f->assign(count, 0);
-  }
-  std::ptrdiff_t stride(int a) const {
-    return a == 0 ? 1 : a == 1 ? dims[0] : static_cast<std::ptrdiff_t>(dims[0]) * dims[1];
-  }
-  AmpmNodeBox box() const {
-    AmpmNodeBox b;
-    for (int a = 0; a < 3; ++a) b.lo[a] = lo[a], b.dims[a] = dims[a];
-    return b;
   }
   template <class U = T>
   typename Api<U, D>::Channel out(std::vector<U>& f) const {

@@ -1,28 +1,14 @@
-// The checks: counters of checks and failures, CHECK (a condition, printf details on failure)
-// and CHECK_OK (a call's status and first_failed).
+// The checks: CHECK and its counters (plain_check.hpp), and CHECK_OK (a call's status and
+// first_failed).
 #pragma once
 
 #include <cstddef>
 #include <cstdint>
 
 #include "ampm.h"
-
-#include <cstdio>
+#include "plain_check.hpp"
 
 namespace {
-
-long g_checks = 0, g_failures = 0;
-
-#define CHECK(cond, ...)                                                        \
-  do {                                                                          \
-    ++g_checks;                                                                 \
-    if (!(cond)) {                                                              \
-      ++g_failures;                                                             \
-      std::fprintf(stderr, "%s:%d: FAIL %s: ", __FILE__, __LINE__, #cond);      \
-      std::fprintf(stderr, __VA_ARGS__);                                        \
-      std::fputc('\n', stderr);                                                 \
-    }                                                                           \
-  } while (0)
 
 #define CHECK_OK(call, n)                                                                  \
   do {                                                                                     \

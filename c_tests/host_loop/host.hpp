@@ -6,6 +6,7 @@
 #include <cstdint>
 
 #include "ampm.h"
+#include "dense_box.hpp"
 
 #include <vector>
 
@@ -68,30 +69,15 @@ struct Particles {
 
 /// The host's grid over a node box, dense arrays, x fastest.
 template <class T, int D>
-struct Grid {
-  int lo[3] = {0, 0, 0}, dims[3] = {1, 1, 1};
-  std::size_t count = 0;
+struct Grid : ampm_test::DenseBox {
   std::vector<T> mass, hc, te, cond, tnew, told;
   std::vector<T> mom[3], force[3], vel[3], mom2[3];
 
   void reset(const int* l, const int* h) {
-    count = 1;
-    for (int a = 0; a < 3; ++a) {
-      lo[a] = a < D ? l[a] : 0;
-      dims[a] = a < D ? h[a] - l[a] + 1 : 1;
-      count *= static_cast<std::size_t>(dims[a]);
-    }
+    set_box(D, l, h);
     for (auto* f : {&mass, &hc, &te, &cond, &tnew, &told}) f->assign(count, 0);
     for (int a = 0; a < 3; ++a)
       for (auto* f : {&mom[a], &force[a], &vel[a], &mom2[a]}) f->assign(count, 0);
-  }
-  std::ptrdiff_t stride(int a) const {
-    return a == 0 ? 1 : a == 1 ? dims[0] : static_cast<std::ptrdiff_t>(dims[0]) * dims[1];
-  }
-  AmpmNodeBox box() const {
-    AmpmNodeBox b;
-    for (int a = 0; a < 3; ++a) b.lo[a] = lo[a], b.dims[a] = dims[a];
-    return b;
   }
   typename Api<T, D>::Channel out(std::vector<T>& f) const {
     typename Api<T, D>::Channel c;

@@ -3,6 +3,7 @@
 #pragma once
 
 #include "common.hpp"
+#include "dense_box.hpp"
 
 #include <algorithm>
 #include <array>
@@ -44,25 +45,14 @@ struct Parts {
 
 /// The host's grid: a node box and dense x-fastest arrays.
 template <class T>
-struct Grid {
-  std::array<int, 3> lo{}, dims{};
-  std::size_t count = 0;
+struct Grid : ampm_test::DenseBox {
   std::vector<T> mass;
   std::array<std::vector<T>, 3> mom, force, vstar;
   void reset(const int* l, const int* h) {
-    count = 1;
-    for (int a = 0; a < 3; ++a) lo[a] = l[a], dims[a] = h[a] - l[a] + 1, count *= dims[a];
+    set_box(3, l, h);
     mass.assign(count, 0);
     for (int a = 0; a < 3; ++a)
       mom[a].assign(count, 0), force[a].assign(count, 0), vstar[a].assign(count, 0);
-  }
-  std::ptrdiff_t stride(int a) const {
-    return a == 0 ? 1 : a == 1 ? dims[0] : static_cast<std::ptrdiff_t>(dims[0]) * dims[1];
-  }
-  AmpmNodeBox box() const {
-    AmpmNodeBox b;
-    for (int a = 0; a < 3; ++a) b.lo[a] = lo[a], b.dims[a] = dims[a];
-    return b;
   }
   std::size_t at(const int* i) const {
     return static_cast<std::size_t>(i[0] - lo[0]) +
