@@ -232,8 +232,8 @@ mod tests {
     use super::*;
 
     /// Every instruction set of this CPU survives the stored form with its joined-rows and
-    /// narrow-chunks flags, every value of the flags round-trips, and `set_isa` then `isa` gives back what
-    /// `Isa::available` listed (the choice is restored afterwards).
+    /// narrow-chunks flags, every value of the flags round-trips, and `set_isa` then `isa`
+    /// gives back what `Isa::available` listed (the choice is restored afterwards).
     #[test]
     fn stored_isa_round_trips() {
         for i in Isa::available() {

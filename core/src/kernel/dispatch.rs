@@ -1,9 +1,9 @@
 //! Running a chunk loop on an instruction set: the loop is generic over its lane types
 //! ([`LaneOp`]) and `#[inline(always)]` down to the intrinsics; [`dispatch`] instantiates it
 //! inside a `#[target_feature]` function per instruction set (AVX2, AVX-512 with or without
-//! VL, joined rows and narrow chunks) and calls the one an [`Isa`] names. The scalars with SIMD paths
-//! ([`BatchReal`]) name their lane types per instruction set, and [`BatchStatus`] is the
-//! outcome every batch call reports.
+//! VL, joined rows and narrow chunks) and calls the one an [`Isa`] names. The scalars with
+//! SIMD paths ([`BatchReal`]) name their lane types per instruction set, and [`BatchStatus`]
+//! is the outcome every batch call reports.
 
 use crate::error::Error;
 use crate::lane::{Isa, IsaKind, Lane, Pair, X2};
