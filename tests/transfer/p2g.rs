@@ -7,7 +7,7 @@ use ampm_core::lane::{Isa, IsaKind};
 use ampm_core::particle::transfer::p2g::{self, P2gArgs, P2gView};
 use ampm_core::particle::transfer::{Channel, NodeBox};
 use ampm_core::particle::update;
-use ampm_core::particle::{Grid, Kernel, Material, Particle, Stencil};
+use ampm_core::particle::{Grid, Kernel, Material, Particle, Phase, Stencil};
 use ampm_core::polar::{DefaultSvd, SvdMethod};
 use ampm_core::{Error, Mat, Matrix, Real};
 use ampm_tools::workload::HaarRotation;
@@ -492,7 +492,8 @@ fn p2g_run_that_overflows_is_added_one_by_one() {
 /// Their node sums have the bits of the per-channel form (the same channels with the force
 /// channels also written), and the same bits on every vector instruction set, with and
 /// without the impulse term. The particles are sorted by cell, as a host sorts them, so that
-/// long runs share a node tile.
+/// long runs share a node tile. Each material also runs as a batch of liquid particles only
+/// (`μ = 0`), whose chunks sum an isotropic force without the terms of its zero entries.
 fn fixed_channel_sets_give_the_per_channel_bits<T: BatchReal, const D: usize>()
 where
     Dim<D>: LaneDim<D>,
@@ -503,9 +504,23 @@ where
     let (cells, hf) = (10, 0.05);
     let h = T::from_f64(hf);
     let (lo, dims) = ([-1; D], [cells + 2; D]);
-    for (name, mat) in materials::<T>() {
+    let all = materials::<T>().into_iter();
+    for (name, mat, liquid) in all.flat_map(|(n, m)| [(n, m, false), (n, m, true)]) {
         let mut rng = Pcg64::seed_from_u64(13);
         let mut ps = particles::<T, D>(&mut rng, 300, hf, cells, &mat);
+        if liquid {
+            for p in &mut ps {
+                // A liquid's thermal state: above the melting point, its latent heat taken.
+                p.phase = Phase::Liquid;
+                p.temperature = T::from_f64(crate::TM + 5.0);
+                p.latent = T::from_f64(crate::LATENT);
+            }
+        }
+        let name = if liquid {
+            format!("{name} (liquid)")
+        } else {
+            name.to_string()
+        };
         let cell = |p: &Particle<T, D>| -> [i64; D] {
             let mut c = [0i64; D];
             for a in 0..D {

@@ -68,6 +68,8 @@ pub(super) const MAX_CH: usize = 10;
 const MAX_PAIRS: usize = MAX_CH / 2;
 /// Largest dimension.
 const MAX_D: usize = 3;
+/// Every `B_a` term of a channel (the mask of [`add_channel`]).
+const ALL_B: u8 = u8::MAX;
 
 /// The per-particle lane vectors of one channel's node values (see the module docs). A term
 /// that the channel does not have is skipped (`has_e`, `has_b` false). Plain arrays and flags
@@ -212,10 +214,12 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
                 let c = Coef::join::<Q>(&pair[0], pair.get(1).unwrap_or(&none));
                 let acc = &mut self.pairs()[p];
                 match (c.has_e, c.has_b) {
-                    (false, false) => add_channel::<T, Q, D, K, false, false>(acc, rt, st, &c),
-                    (true, false) => add_channel::<T, Q, D, K, true, false>(acc, rt, st, &c),
-                    (false, true) => add_channel::<T, Q, D, K, false, true>(acc, rt, st, &c),
-                    (true, true) => add_channel::<T, Q, D, K, true, true>(acc, rt, st, &c),
+                    (false, false) => {
+                        add_channel::<T, Q, D, K, false, false>(acc, rt, st, &c, ALL_B)
+                    }
+                    (true, false) => add_channel::<T, Q, D, K, true, false>(acc, rt, st, &c, ALL_B),
+                    (false, true) => add_channel::<T, Q, D, K, false, true>(acc, rt, st, &c, ALL_B),
+                    (true, true) => add_channel::<T, Q, D, K, true, true>(acc, rt, st, &c, ALL_B),
                 }
             }
             return;
@@ -223,10 +227,10 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
         for (j, k) in coef.iter().enumerate() {
             let acc = &mut self.acc[j];
             match (k.has_e, k.has_b) {
-                (false, false) => add_channel::<T, R, D, K, false, false>(acc, rt, st, k),
-                (true, false) => add_channel::<T, R, D, K, true, false>(acc, rt, st, k),
-                (false, true) => add_channel::<T, R, D, K, false, true>(acc, rt, st, k),
-                (true, true) => add_channel::<T, R, D, K, true, true>(acc, rt, st, k),
+                (false, false) => add_channel::<T, R, D, K, false, false>(acc, rt, st, k, ALL_B),
+                (true, false) => add_channel::<T, R, D, K, true, false>(acc, rt, st, k, ALL_B),
+                (false, true) => add_channel::<T, R, D, K, false, true>(acc, rt, st, k, ALL_B),
+                (true, true) => add_channel::<T, R, D, K, true, true>(acc, rt, st, k, ALL_B),
             }
         }
     }
@@ -263,8 +267,10 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
 
     /// [`Self::add`] for the channels mass (`P` only) and momentum along each axis (`E_a`, and
     /// `B_a` when `B`), `coef.0[0..=D]`, then with `heat` the three heat channels (`P` only),
-    /// `coef.1`; the terms are known at compile time (`heat` is a constant where it is
-    /// inlined).
+    /// `coef.1`; the terms are known at compile time (`heat` and `iso` are constants where it
+    /// is inlined). With `iso` the force is isotropic (`fm = s I`, a particle without shear
+    /// stress): momentum `a` has no `B_b` for `b ≠ a`, and those terms are skipped (the same
+    /// sums: they are exact zeros, and a tile row, which starts at `+0`, is never `−0`).
     #[inline(always)]
     pub fn add_fixed<const K: usize, const B: bool>(
         &mut self,
@@ -272,33 +278,46 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
         st: &Stencil<T, D>,
         (mm, hc): &([Coef<R, D>; 4], [Coef<R, D>; 3]),
         heat: bool,
+        iso: bool,
     ) {
         debug_assert!(mm[1..=D].iter().all(|k| k.has_e && k.has_b == B));
         let rt = self.mark_rows::<K>(s);
+        // With an isotropic force the momentum along axis `a` has the term `B_a` only.
+        let bm = |a: usize| if iso { 1u8 << a } else { ALL_B };
+        let bm = [bm(0), bm(1), bm(2)];
         if Self::PAIRED {
             // Pairs in channel order (3D): (mass, momentum 0), (momentum 1, momentum 2), then
             // the heat channels.
             let none = Coef::only(R::splat(T::ZERO));
             let pairs = self.pairs();
             let c = Coef::join_all::<Q>(&mm[0], &mm[1]);
-            add_channel::<T, Q, D, K, true, B>(&mut pairs[0], &rt, st, &c);
+            add_channel::<T, Q, D, K, true, B>(&mut pairs[0], &rt, st, &c, bm[0]);
             let c = Coef::join_all::<Q>(&mm[2], &mm[3]);
-            add_channel::<T, Q, D, K, true, B>(&mut pairs[1], &rt, st, &c);
+            add_channel::<T, Q, D, K, true, B>(&mut pairs[1], &rt, st, &c, ALL_B);
             if heat {
                 let c = Coef::join_all::<Q>(&hc[0], &hc[1]);
-                add_channel::<T, Q, D, K, false, false>(&mut pairs[2], &rt, st, &c);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[2], &rt, st, &c, ALL_B);
                 let c = Coef::join_all::<Q>(&hc[2], &none);
-                add_channel::<T, Q, D, K, false, false>(&mut pairs[3], &rt, st, &c);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[3], &rt, st, &c, ALL_B);
             }
             return;
         }
-        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0]);
-        for a in 1..=D {
-            add_channel::<T, R, D, K, true, B>(&mut self.acc[a], &rt, st, &mm[a]);
+        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0], ALL_B);
+        // Written out per axis, so that each `bm` is a constant.
+        add_channel::<T, R, D, K, true, B>(&mut self.acc[1], &rt, st, &mm[1], bm[0]);
+        add_channel::<T, R, D, K, true, B>(&mut self.acc[2], &rt, st, &mm[2], bm[1]);
+        if D == 3 {
+            add_channel::<T, R, D, K, true, B>(&mut self.acc[3], &rt, st, &mm[3], bm[2]);
         }
         if heat {
             for (h, k) in hc.iter().enumerate() {
-                add_channel::<T, R, D, K, false, false>(&mut self.acc[D + 1 + h], &rt, st, k);
+                add_channel::<T, R, D, K, false, false>(
+                    &mut self.acc[D + 1 + h],
+                    &rt,
+                    st,
+                    k,
+                    ALL_B,
+                );
             }
         }
     }
@@ -319,13 +338,13 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
             let pairs = self.pairs();
             // (3D) The forces along axes 0 and 1, then along axis 2.
             let c = Coef::join_all::<Q>(&coef[0], &coef[1]);
-            add_channel::<T, Q, D, K, E, B>(&mut pairs[0], &rt, st, &c);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[0], &rt, st, &c, ALL_B);
             let c = Coef::join_all::<Q>(&coef[D - 1], &none);
-            add_channel::<T, Q, D, K, E, B>(&mut pairs[1], &rt, st, &c);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[1], &rt, st, &c, ALL_B);
             return;
         }
         for (acc, k) in self.acc.iter_mut().zip(coef) {
-            add_channel::<T, R, D, K, E, B>(acc, &rt, st, k);
+            add_channel::<T, R, D, K, E, B>(acc, &rt, st, k, ALL_B);
         }
     }
 
@@ -403,9 +422,11 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>> Rows<Q> for PairRows<R> {
     }
 }
 
-/// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B`)
-/// into the tile rows `rt` (see [`Tile::add`]): per axis-2 offset `o₂` the vectors `U`, `V`,
-/// `W_B` of the module docs, then per axis-1 offset `o₁` two multiply-adds.
+/// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B` and
+/// bit `a` of `bm` is set) into the tile rows `rt` (see [`Tile::add`]): per axis-2 offset `o₂`
+/// the vectors `U`, `V`, `W_B` of the module docs, then per axis-1 offset `o₁` two
+/// multiply-adds. `bm` is a constant where this is inlined ([`ALL_B`], or one axis of an
+/// isotropic force), so the terms left out cost nothing.
 #[inline(always)]
 fn add_channel<
     T: Real,
@@ -419,8 +440,10 @@ fn add_channel<
     rt: &[[usize; MAX_WIDTH]; MAX_WIDTH],
     st: &Stencil<T, D>,
     k: &Coef<R, D>,
+    bm: u8,
 ) {
     let sp = R::splat;
+    let (b1, b2) = (B && bm & 2 != 0, B && bm & 4 != 0);
     for (o2, row) in rt.iter().enumerate().take(outer::<D, K>()) {
         let (mut u, mut v, mut wb) = (k.p, k.e[1], k.b[1]);
         if D == 3 {
@@ -430,8 +453,10 @@ fn add_channel<
                 v = w2 * v;
             }
             u = w2 * u;
-            if B {
+            if b2 {
                 u = sp(st.dw[2][o2]).mul_add(k.b[2], u);
+            }
+            if b1 {
                 wb = w2 * wb;
             }
         }
@@ -442,7 +467,7 @@ fn add_channel<
                 u
             };
             let mut a = sp(st.w[1][o1]).mul_add(y, acc.get(t));
-            if B {
+            if b1 {
                 a = sp(st.dw[1][o1]).mul_add(wb, a);
             }
             acc.set(t, a);

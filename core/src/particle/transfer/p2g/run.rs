@@ -136,12 +136,17 @@ where
         r: &Ready<'_, T, D>,
         s0: usize,
         heat: bool,
+        iso: bool,
     ) -> ([Coef<R, D>; 4], [Coef<R, D>; 3]) {
         let lanes = axis0::<T, R, D, K>(r.s, s0);
         let z = Coef::only(R::splat(T::ZERO));
         let (mut mm, mut hc) = ([z; 4], [z; 3]);
         for (kind, c) in mm.iter_mut().enumerate().take(D + 1) {
-            self.channel_coef(r, lanes, kind, B, c);
+            if B && iso && kind > 0 {
+                self.momentum_iso(r, lanes, kind - 1, c);
+            } else {
+                self.channel_coef(r, lanes, kind, B, c);
+            }
         }
         if heat {
             for (h, c) in hc.iter_mut().enumerate() {
@@ -149,6 +154,33 @@ where
             }
         }
         (mm, hc)
+    }
+
+    /// The lane vectors of the momentum along axis `a` (`Δt_f ≠ 0`) where the force is
+    /// isotropic, `fm = s I` (see [`Tile::add_fixed`]): [`Self::channel_coef`] without the
+    /// terms of `fm`'s zero entries, which leaves `B_b` (`b ≠ a`) zero.
+    #[inline(always)]
+    fn momentum_iso<R: Lane<Scalar = T>>(
+        &self,
+        r: &Ready<'_, T, D>,
+        (w, dw, o0): (R, R, R),
+        a: usize,
+        c: &mut Coef<R, D>,
+    ) {
+        let sp = R::splat;
+        let idt = self.args.impulse_dt;
+        let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
+        if a == 0 {
+            c.p = w.mul_add(q, dw * sp(idt * r.fm.cols[0][0]));
+        } else {
+            c.p = w * q;
+            c.b[a] = w * sp(idt * r.fm.cols[a][a]);
+        }
+        for b in 1..D {
+            c.e[b] = w * sp(r.mch.cols[b][a]);
+        }
+        c.has_e = true;
+        c.has_b = true;
     }
 
     /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
@@ -189,7 +221,8 @@ where
     }
 
     /// Adds a ready particle `i` to the tile run, after adding the run to the grid if the
-    /// particle does not fit in its tile or the run is full.
+    /// particle does not fit in its tile or the run is full; `iso` when its force is isotropic
+    /// (no shear stress: `tau_dev = 0`).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     unsafe fn tile_add<
@@ -202,7 +235,7 @@ where
         &mut self,
         i: usize,
         r: &Ready<'_, T, D>,
-        tau_dev: Mat<T, D>,
+        (tau_dev, iso): (Mat<T, D>, bool),
         tile: &mut Tile<R, Q, D>,
         run: &mut Run<T, D>,
         oc: &[[T; N]; D],
@@ -227,11 +260,14 @@ where
             // A constant in each loop (`SET`), so the heat terms fold away or stay.
             let heat = SET == WITH_HEAT;
             if idt == T::ZERO {
-                let c = self.fixed_coef::<R, K, false>(r, s[0], heat);
-                tile.add_fixed::<K, false>(&s, r.s, &c, heat);
+                let c = self.fixed_coef::<R, K, false>(r, s[0], heat, false);
+                tile.add_fixed::<K, false>(&s, r.s, &c, heat, false);
+            } else if iso {
+                let c = self.fixed_coef::<R, K, true>(r, s[0], heat, true);
+                tile.add_fixed::<K, true>(&s, r.s, &c, heat, true);
             } else {
-                let c = self.fixed_coef::<R, K, true>(r, s[0], heat);
-                tile.add_fixed::<K, true>(&s, r.s, &c, heat);
+                let c = self.fixed_coef::<R, K, true>(r, s[0], heat, false);
+                tile.add_fixed::<K, true>(&s, r.s, &c, heat, false);
             }
         }
         run.idx[run.n] = i;
@@ -276,9 +312,10 @@ where
         self.scatter::<R, K, N>(&r, oc)
     }
 
-    /// Adds particle `i` with deviatoric stress `tau_dev` to the tile run: its scalar pass
-    /// `pre`, or its lane of the chunk's `ChunkBufs` when its pass ran on lanes;
-    /// `x` its position; `lane_stencil` its stencil if the lanes made it.
+    /// Adds particle `i` with deviatoric stress `tau_dev` (and `iso` when that is 0 without
+    /// a shear modulus) to the tile run: its scalar pass `pre`, or its lane of the chunk's
+    /// `ChunkBufs` when its pass ran on lanes; `x` its position; `lane_stencil` its stencil
+    /// if the lanes made it.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     unsafe fn finish<
@@ -292,7 +329,7 @@ where
         &mut self,
         i: usize,
         (pre, from_lanes, x): Source<'_, T, D, L>,
-        tau_dev: Mat<T, D>,
+        tau @ (tau_dev, _): (Mat<T, D>, bool),
         lane_stencil: Option<&Stencil<T, D>>,
         (tile, run): (&mut Tile<R, Q, D>, &mut Run<T, D>),
         oc: &[[T; N]; D],
@@ -316,7 +353,7 @@ where
         };
         let r = match ready {
             Err(e) => Err(e),
-            Ok(r) => self.tile_add::<R, Q, K, N, SET>(i, &r, tau_dev, tile, run, oc, coef),
+            Ok(r) => self.tile_add::<R, Q, K, N, SET>(i, &r, tau, tile, run, oc, coef),
         };
         self.first.note(i, r);
     }
@@ -515,9 +552,11 @@ where
                     *e = kernel_lane_error(&bits, flagged_lanes, l, b.mu[l]);
                 }
             }
-            for j in 0..D {
-                for r in 0..D {
-                    tau[j][r].store(&mut b.tau[r + D * j][..lanes]);
+            if any_mu {
+                for j in 0..D {
+                    for r in 0..D {
+                        tau[j][r].store(&mut b.tau[r + D * j][..lanes]);
+                    }
                 }
             }
             if fast != 0 {
@@ -529,10 +568,13 @@ where
                         self.first.note(start + l, Err(e));
                         continue;
                     }
+                    // No shear stress in the chunk (every μ = 0): an isotropic force.
                     let mut tau = Mat::<T, D>::ZERO;
-                    for j in 0..D {
-                        for r in 0..D {
-                            tau.cols[j][r] = b.tau[r + D * j][l];
+                    if any_mu {
+                        for j in 0..D {
+                            for r in 0..D {
+                                tau.cols[j][r] = b.tau[r + D * j][l];
+                            }
                         }
                     }
                     let from_lanes = (fast >> l & 1 == 1).then_some((&b, l));
@@ -541,7 +583,7 @@ where
                         self.finish::<R, Q, K, N, SET, L>(
                             start + l,
                             (&pres[l], from_lanes, &xs[l]),
-                            tau,
+                            (tau, !any_mu),
                             (done >> l & 1 == 1).then_some(&stencils[l]),
                             (&mut tile, &mut run),
                             &oc,
