@@ -87,6 +87,8 @@ impl<M: Matrix> Kinematics<M> {
         // Also catches F = 0 (det 0) and det G that is NaN-free but not positive. Below the
         // smallest normal number, det Ĝ says F is singular to working precision (Hadamard
         // ratio ∏‖g_j‖/|det G| beyond 1/MIN_POSITIVE ≫ 1/ε).
+        // Negated, so that a NaN determinant fails the check too.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
         if !(det_h >= M::Scalar::MIN_POSITIVE) {
             return Err(Error::NonPositiveJ);
         }

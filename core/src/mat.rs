@@ -45,8 +45,8 @@ impl<T: Real, const D: usize> Mat<T, D> {
     #[must_use]
     pub fn from_diagonal(d: [T; D]) -> Self {
         let mut m = Self::ZERO;
-        for i in 0..D {
-            m.cols[i][i] = d[i];
+        for (i, x) in d.into_iter().enumerate() {
+            m.cols[i][i] = x;
         }
         m
     }
@@ -194,9 +194,9 @@ impl<T: Real, const D: usize> Mat<T, D> {
     #[must_use]
     pub fn mul_vec(&self, v: [T; D]) -> [T; D] {
         let mut r = [T::ZERO; D];
-        for j in 0..D {
-            for i in 0..D {
-                r[i] += self.cols[j][i] * v[j];
+        for (col, vj) in self.cols.iter().zip(v) {
+            for (ri, cij) in r.iter_mut().zip(col) {
+                *ri += *cij * vj;
             }
         }
         r
@@ -207,9 +207,9 @@ impl<T: Real, const D: usize> Mat<T, D> {
     #[must_use]
     pub fn outer(a: [T; D], b: [T; D]) -> Self {
         let mut m = Self::ZERO;
-        for j in 0..D {
-            for i in 0..D {
-                m.cols[j][i] = a[i] * b[j];
+        for (col, bj) in m.cols.iter_mut().zip(b) {
+            for (mij, ai) in col.iter_mut().zip(a) {
+                *mij = ai * bj;
             }
         }
         m

@@ -186,7 +186,7 @@ where
 {
     let e = D * D;
     let n = sigma.len() / D;
-    if sigma.len() % D != 0 || f.len() != n * e || u.len() != n * e || v.len() != n * e {
+    if !sigma.len().is_multiple_of(D) || f.len() != n * e || u.len() != n * e || v.len() != n * e {
         return Err(Error::InvalidArgument);
     }
     Ok(dispatch::<T, _>(isa, &mut SvdOp::<T, D> { f, u, sigma, v }))
@@ -469,7 +469,7 @@ where
     Dim<D>: LaneDim<D>,
 {
     let w = prepared::len(D);
-    if prepared.len() % w != 0 {
+    if !prepared.len().is_multiple_of(w) {
         return Err(Error::InvalidArgument);
     }
     let n = prepared.len() / w;

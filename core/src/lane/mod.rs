@@ -348,9 +348,6 @@ impl<R: Lane> Pair<R> for X2<R> {
     }
 }
 
-/// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
-/// (`libm`), so this is also what `no_std` targets run.
-
 /// [`Lane::load_rows`] by scalar reads (any axis-0 stride `s0`): its default, and the strided
 /// case of the types that override it.
 ///
@@ -393,6 +390,8 @@ pub(crate) fn quad_sums_in_memory<V: Lane>(v: [V; 4]) -> V {
     V::load(&o)
 }
 
+/// The scalar instantiation: one lane, `Mask = bool`. The operations are those of [`Real`]
+/// (`libm`), so this is also what `no_std` targets run.
 impl<T: Real> Lane for T {
     type Scalar = T;
     type Mask = bool;

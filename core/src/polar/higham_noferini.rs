@@ -129,12 +129,9 @@ pub(crate) fn sym_jacobi<T: Real, const N: usize>(
     }
     if !converged {
         // The last sweep rotated: accept if every off-diagonal entry is below the threshold.
-        for p in 0..N {
-            for q in p + 1..N {
-                if a[q][p].abs() > thr {
-                    return Err(Error::NotConverged);
-                }
-            }
+        let off = |p: usize| a[p + 1..].iter().any(|aq| aq[p].abs() > thr);
+        if (0..N).any(off) {
+            return Err(Error::NotConverged);
         }
     }
     let mut d = [T::ZERO; N];

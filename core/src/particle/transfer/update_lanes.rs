@@ -156,7 +156,7 @@ fn scaled<V: Lane, const D: usize>(m: &LMat<V, D>, s: V) -> LMat<V, D> {
     let mut r = *m;
     for c in r.iter_mut() {
         for x in c.iter_mut() {
-            *x = *x * s;
+            *x *= s;
         }
     }
     r
@@ -226,9 +226,9 @@ fn root_det<T: Real, V: Lane<Scalar = T>, const D: usize>(m: &LMat<V, D>) -> (V,
         let ej = V::select(col_ok, ej, zero);
         let p = V::pow2(-ej);
         for x in g[j].iter_mut() {
-            *x = *x * p;
+            *x *= p;
         }
-        e = e + ej;
+        e += ej;
     }
     let det = lmat::det(&g);
     ok = ok & zero.lt(det);
@@ -367,7 +367,7 @@ pub(super) unsafe fn update<T: Real, V: Lane<Scalar = T>, const D: usize>(
 ) -> bool {
     debug_assert!(V::LANES == LANES && D <= MAX_D);
     let inv_h = T::ONE / h;
-    if !(dt.is_finite() && dt > T::ZERO && h.is_finite() && h > T::ZERO) || !inv_h.is_finite() {
+    if !(dt.is_finite() && dt > T::ZERO && h.is_finite() && h > T::ZERO && inv_h.is_finite()) {
         return false;
     }
     let mut heat_new = [ThermalState {
