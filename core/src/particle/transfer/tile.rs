@@ -68,7 +68,7 @@ pub(super) const MAX_CH: usize = 10;
 const MAX_PAIRS: usize = MAX_CH / 2;
 /// Largest dimension.
 const MAX_D: usize = 3;
-/// Every `B_a` term of a channel (the mask of [`add_channel`]).
+/// Every `B_a` term of a channel (the mask of [`masked_channel`]).
 const ALL_B: u8 = u8::MAX;
 
 /// The per-particle lane vectors of one channel's node values (see the module docs). A term
@@ -214,12 +214,10 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
                 let c = Coef::join::<Q>(&pair[0], pair.get(1).unwrap_or(&none));
                 let acc = &mut self.pairs()[p];
                 match (c.has_e, c.has_b) {
-                    (false, false) => {
-                        add_channel::<T, Q, D, K, false, false>(acc, rt, st, &c, ALL_B)
-                    }
-                    (true, false) => add_channel::<T, Q, D, K, true, false>(acc, rt, st, &c, ALL_B),
-                    (false, true) => add_channel::<T, Q, D, K, false, true>(acc, rt, st, &c, ALL_B),
-                    (true, true) => add_channel::<T, Q, D, K, true, true>(acc, rt, st, &c, ALL_B),
+                    (false, false) => add_channel::<T, Q, D, K, false, false>(acc, rt, st, &c),
+                    (true, false) => add_channel::<T, Q, D, K, true, false>(acc, rt, st, &c),
+                    (false, true) => add_channel::<T, Q, D, K, false, true>(acc, rt, st, &c),
+                    (true, true) => add_channel::<T, Q, D, K, true, true>(acc, rt, st, &c),
                 }
             }
             return;
@@ -227,10 +225,10 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
         for (j, k) in coef.iter().enumerate() {
             let acc = &mut self.acc[j];
             match (k.has_e, k.has_b) {
-                (false, false) => add_channel::<T, R, D, K, false, false>(acc, rt, st, k, ALL_B),
-                (true, false) => add_channel::<T, R, D, K, true, false>(acc, rt, st, k, ALL_B),
-                (false, true) => add_channel::<T, R, D, K, false, true>(acc, rt, st, k, ALL_B),
-                (true, true) => add_channel::<T, R, D, K, true, true>(acc, rt, st, k, ALL_B),
+                (false, false) => add_channel::<T, R, D, K, false, false>(acc, rt, st, k),
+                (true, false) => add_channel::<T, R, D, K, true, false>(acc, rt, st, k),
+                (false, true) => add_channel::<T, R, D, K, false, true>(acc, rt, st, k),
+                (true, true) => add_channel::<T, R, D, K, true, true>(acc, rt, st, k),
             }
         }
     }
@@ -284,40 +282,33 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
         let rt = self.mark_rows::<K>(s);
         // With an isotropic force the momentum along axis `a` has the term `B_a` only.
         let bm = |a: usize| if iso { 1u8 << a } else { ALL_B };
-        let bm = [bm(0), bm(1), bm(2)];
         if Self::PAIRED {
             // Pairs in channel order (3D): (mass, momentum 0), (momentum 1, momentum 2), then
             // the heat channels.
             let none = Coef::only(R::splat(T::ZERO));
             let pairs = self.pairs();
             let c = Coef::join_all::<Q>(&mm[0], &mm[1]);
-            add_channel::<T, Q, D, K, true, B>(&mut pairs[0], &rt, st, &c, bm[0]);
+            masked_channel::<T, Q, D, K, true, B>(&mut pairs[0], &rt, st, &c, bm(0));
             let c = Coef::join_all::<Q>(&mm[2], &mm[3]);
-            add_channel::<T, Q, D, K, true, B>(&mut pairs[1], &rt, st, &c, ALL_B);
+            add_channel::<T, Q, D, K, true, B>(&mut pairs[1], &rt, st, &c);
             if heat {
                 let c = Coef::join_all::<Q>(&hc[0], &hc[1]);
-                add_channel::<T, Q, D, K, false, false>(&mut pairs[2], &rt, st, &c, ALL_B);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[2], &rt, st, &c);
                 let c = Coef::join_all::<Q>(&hc[2], &none);
-                add_channel::<T, Q, D, K, false, false>(&mut pairs[3], &rt, st, &c, ALL_B);
+                add_channel::<T, Q, D, K, false, false>(&mut pairs[3], &rt, st, &c);
             }
             return;
         }
-        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0], ALL_B);
+        add_channel::<T, R, D, K, false, false>(&mut self.acc[0], &rt, st, &mm[0]);
         // Written out per axis, so that each `bm` is a constant.
-        add_channel::<T, R, D, K, true, B>(&mut self.acc[1], &rt, st, &mm[1], bm[0]);
-        add_channel::<T, R, D, K, true, B>(&mut self.acc[2], &rt, st, &mm[2], bm[1]);
+        masked_channel::<T, R, D, K, true, B>(&mut self.acc[1], &rt, st, &mm[1], bm(0));
+        masked_channel::<T, R, D, K, true, B>(&mut self.acc[2], &rt, st, &mm[2], bm(1));
         if D == 3 {
-            add_channel::<T, R, D, K, true, B>(&mut self.acc[3], &rt, st, &mm[3], bm[2]);
+            masked_channel::<T, R, D, K, true, B>(&mut self.acc[3], &rt, st, &mm[3], bm(2));
         }
         if heat {
             for (h, k) in hc.iter().enumerate() {
-                add_channel::<T, R, D, K, false, false>(
-                    &mut self.acc[D + 1 + h],
-                    &rt,
-                    st,
-                    k,
-                    ALL_B,
-                );
+                add_channel::<T, R, D, K, false, false>(&mut self.acc[D + 1 + h], &rt, st, k);
             }
         }
     }
@@ -338,13 +329,13 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>, const D: usize> Tile<R, Q, D> {
             let pairs = self.pairs();
             // (3D) The forces along axes 0 and 1, then along axis 2.
             let c = Coef::join_all::<Q>(&coef[0], &coef[1]);
-            add_channel::<T, Q, D, K, E, B>(&mut pairs[0], &rt, st, &c, ALL_B);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[0], &rt, st, &c);
             let c = Coef::join_all::<Q>(&coef[D - 1], &none);
-            add_channel::<T, Q, D, K, E, B>(&mut pairs[1], &rt, st, &c, ALL_B);
+            add_channel::<T, Q, D, K, E, B>(&mut pairs[1], &rt, st, &c);
             return;
         }
         for (acc, k) in self.acc.iter_mut().zip(coef) {
-            add_channel::<T, R, D, K, E, B>(acc, &rt, st, k, ALL_B);
+            add_channel::<T, R, D, K, E, B>(acc, &rt, st, k);
         }
     }
 
@@ -422,13 +413,31 @@ impl<T: Real, R: Lane<Scalar = T>, Q: Pair<R>> Rows<Q> for PairRows<R> {
     }
 }
 
-/// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B` and
-/// bit `a` of `bm` is set) into the tile rows `rt` (see [`Tile::add`]): per axis-2 offset `o₂`
-/// the vectors `U`, `V`, `W_B` of the module docs, then per axis-1 offset `o₁` two
-/// multiply-adds. `bm` is a constant where this is inlined ([`ALL_B`], or one axis of an
-/// isotropic force), so the terms left out cost nothing.
+/// Adds one channel's node values (lane vectors `k`, terms `E_a` when `E`, `B_a` when `B`)
+/// into the tile rows `rt` (see [`Tile::add`]): [`masked_channel`] with every `B_a`.
 #[inline(always)]
 fn add_channel<
+    T: Real,
+    R: Lane<Scalar = T>,
+    const D: usize,
+    const K: usize,
+    const E: bool,
+    const B: bool,
+>(
+    acc: &mut impl Rows<R>,
+    rt: &[[usize; MAX_WIDTH]; MAX_WIDTH],
+    st: &Stencil<T, D>,
+    k: &Coef<R, D>,
+) {
+    masked_channel::<T, R, D, K, E, B>(acc, rt, st, k, ALL_B);
+}
+
+/// [`add_channel`] with the terms `B_a` only where bit `a` of `bm` is set: per axis-2 offset
+/// `o₂` the vectors `U`, `V`, `W_B` of the module docs, then per axis-1 offset `o₁` two
+/// multiply-adds. `bm` is a constant where this is inlined ([`ALL_B`], or the one axis of an
+/// isotropic force), so the terms left out cost nothing.
+#[inline(always)]
+fn masked_channel<
     T: Real,
     R: Lane<Scalar = T>,
     const D: usize,

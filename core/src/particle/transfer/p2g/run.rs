@@ -123,7 +123,7 @@ where
         let lanes = axis0::<T, R, D, K>(r.s, s0);
         let impulse = self.args.impulse_dt != T::ZERO;
         for (c, &kind) in out.iter_mut().zip(&self.kinds[..self.na]) {
-            self.channel_coef(r, lanes, kind, impulse, c);
+            self.channel_coef(r, lanes, kind, (impulse, false), c);
         }
     }
 
@@ -142,57 +142,28 @@ where
         let z = Coef::only(R::splat(T::ZERO));
         let (mut mm, mut hc) = ([z; 4], [z; 3]);
         for (kind, c) in mm.iter_mut().enumerate().take(D + 1) {
-            if B && iso && kind > 0 {
-                self.momentum_iso(r, lanes, kind - 1, c);
-            } else {
-                self.channel_coef(r, lanes, kind, B, c);
-            }
+            self.channel_coef(r, lanes, kind, (B, iso), c);
         }
         if heat {
             for (h, c) in hc.iter_mut().enumerate() {
-                self.channel_coef(r, lanes, 7 + h, B, c);
+                self.channel_coef(r, lanes, 7 + h, (B, false), c);
             }
         }
         (mm, hc)
     }
 
-    /// The lane vectors of the momentum along axis `a` (`Δt_f ≠ 0`) where the force is
-    /// isotropic, `fm = s I` (see [`Tile::add_fixed`]): [`Self::channel_coef`] without the
-    /// terms of `fm`'s zero entries, which leaves `B_b` (`b ≠ a`) zero.
-    #[inline(always)]
-    fn momentum_iso<R: Lane<Scalar = T>>(
-        &self,
-        r: &Ready<'_, T, D>,
-        (w, dw, o0): (R, R, R),
-        a: usize,
-        c: &mut Coef<R, D>,
-    ) {
-        let sp = R::splat;
-        let idt = self.args.impulse_dt;
-        let q = sp(r.mch.cols[0][a]).mul_add(o0, sp(r.q0[a]));
-        if a == 0 {
-            c.p = w.mul_add(q, dw * sp(idt * r.fm.cols[0][0]));
-        } else {
-            c.p = w * q;
-            c.b[a] = w * sp(idt * r.fm.cols[a][a]);
-        }
-        for b in 1..D {
-            c.e[b] = w * sp(r.mch.cols[b][a]);
-        }
-        c.has_e = true;
-        c.has_b = true;
-    }
-
     /// The lane vectors of channel `kind`'s node values (0 mass, `1 + a` momentum, `4 + a`
     /// force, `7..` heat) from the axis-0 lanes `(w, dw, o₀)` of [`axis0`], into `c` (fields
-    /// that the channel does not use are left as they are); `impulse`: `Δt_f ≠ 0`.
+    /// that the channel does not use are left as they are); `impulse`: `Δt_f ≠ 0`; `iso`: the
+    /// force is isotropic, `fm = s I` (see [`Tile::add_fixed`]), so the momentum along axis `a`
+    /// gets only the terms of `fm`'s diagonal (its other `B_b` stay zero).
     #[inline(always)]
     fn channel_coef<R: Lane<Scalar = T>>(
         &self,
         r: &Ready<'_, T, D>,
         (w, dw, o0): (R, R, R),
         kind: usize,
-        impulse: bool,
+        (impulse, iso): (bool, bool),
         c: &mut Coef<R, D>,
     ) {
         let sp = R::splat;
@@ -206,6 +177,14 @@ where
                 if !impulse {
                     c.p = w * q;
                     c.has_b = false;
+                } else if iso {
+                    if a == 0 {
+                        c.p = w.mul_add(q, dw * sp(idt * r.fm.cols[0][0]));
+                    } else {
+                        c.p = w * q;
+                        c.b[a] = w * sp(idt * r.fm.cols[a][a]);
+                    }
+                    c.has_b = true;
                 } else {
                     set_grad(c, w, dw, &r.fm, a, idt);
                     c.p = w.mul_add(q, c.p);
