@@ -4,10 +4,12 @@
 //   bench_transfers [--out FILE] [--reps R]   time every case, markdown table to stdout and FILE
 //                                             (default docs/bench-transfers.md)
 //   bench_transfers --check                   tiny sizes, agreement checks only (for ctest)
-//   bench_transfers --ab A.so B.so [--reps R] [--block N]
+//   bench_transfers --ab A.so B.so [--reps R] [--block N] [--only TEXT]
 //                                             two builds of libampm.so, loaded with dlopen, timed
 //                                             alternately call by call (A/B comparison); with
-//                                             --block, P2G, G2P and apply in calls of N particles
+//                                             --block, P2G, G2P and apply in calls of N particles;
+//                                             with --only, the cases whose label ("elastic 2D f32
+//                                             AVX-512") contains TEXT (for a profiler)
 //
 // This file holds the command line; the parts are in c_tests/bench_transfers/: host.hpp (the
 // workload: scenes, particles, the host's grid), eigen_baseline.hpp, case.hpp (one case and
@@ -105,9 +107,10 @@ namespace bench {
   std::fprintf(code == 0 ? stdout : stderr,
                "usage: bench_transfers [--out FILE] [--reps R]   time every case (default FILE docs/bench-transfers.md)\n"
                "       bench_transfers --check                   agreement checks only, tiny sizes\n"
-               "       bench_transfers --ab A.so B.so [--reps R] [--block N]\n"
+               "       bench_transfers --ab A.so B.so [--reps R] [--block N] [--only TEXT]\n"
                "                 two builds of libampm.so timed alternately (P2G, G2P and apply in calls of\n"
-               "                 N particles with --block; default one call)\n");
+               "                 N particles with --block; default one call); with --only, the cases whose\n"
+               "                 label (\"elastic 2D f32 AVX-512\") contains TEXT\n");
   std::exit(code);
 }
 
@@ -124,6 +127,7 @@ int main(int argc, char** argv) {
   std::string ab[2];
   bool reps_given = false;
   std::size_t block = 0;
+  std::string only;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--check") {
@@ -138,6 +142,8 @@ int main(int argc, char** argv) {
       const long b = std::atol(argv[++i]);
       if (b < 1) fail("--block wants a positive particle count");
       block = static_cast<std::size_t>(b);
+    } else if (arg == "--only" && i + 1 < argc) {
+      only = argv[++i];
     } else if (arg == "--reps" && i + 1 < argc) {
       reps = std::atoi(argv[++i]);
       if (reps < 1 || reps > 1000) fail("--reps wants 1..1000");
@@ -149,7 +155,7 @@ int main(int argc, char** argv) {
       usage(2);
     }
   }
-  if (!ab[0].empty()) return run_ab(ab[0], ab[1], reps_given ? reps : 31, block);
+  if (!ab[0].empty()) return run_ab(ab[0], ab[1], reps_given ? reps : 31, block, only);
   const std::uint32_t default_isa = ampm_isa();
   std::vector<std::uint32_t> isas;
   for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}, std::uint32_t{AMPM_ISA_SCALAR}})

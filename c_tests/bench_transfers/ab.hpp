@@ -59,10 +59,13 @@ struct AbRow {
 };
 
 /// Times one case on instruction set `isa` with both builds alternately (see the header), the
-/// particles in calls of `block` (0: one call per transfer).
+/// particles in calls of `block` (0: one call per transfer); only if its label ("elastic 2D f32
+/// AVX-512") contains `only`.
 template <class T, int D>
-void ab_case(Scene s, int per_axis, int reps, std::size_t block, std::uint32_t isa, const AbLib* libs[2],
-             std::vector<AbRow>& rows) {
+void ab_case(Scene s, int per_axis, int reps, std::size_t block, const std::string& only, std::uint32_t isa,
+             const AbLib* libs[2], std::vector<AbRow>& rows) {
+  const std::string label = std::string(scene_name(s)) + " " + Api<T, D>::name + " " + isa_name(isa);
+  if (label.find(only) == std::string::npos) return;
   for (int k = 0; k < 2; ++k)
     if (libs[k]->set_isa(isa) != AMPM_OK) return;
   Case<T, D> cs(s, per_axis);
@@ -161,14 +164,14 @@ void ab_case(Scene s, int per_axis, int reps, std::size_t block, std::uint32_t i
 }
 
 /// The A/B comparison (--ab): a markdown table of both builds' medians and their ratio.
-inline int run_ab(const std::string& a, const std::string& b, int reps, std::size_t block) {
+inline int run_ab(const std::string& a, const std::string& b, int reps, std::size_t block, const std::string& only) {
   const AbLib la(a), lb(b);
   const AbLib* libs[2] = {&la, &lb};
   std::vector<AbRow> rows;
   for (Scene s : {Scene::Elastic, Scene::Fluid, Scene::Thermal})
     for (std::uint32_t isa : {std::uint32_t{AMPM_ISA_AVX512}, std::uint32_t{AMPM_ISA_AVX2}}) {
-      ab_case<float, 3>(s, 38, reps, block, isa, libs, rows);
-      ab_case<float, 2>(s, 234, reps, block, isa, libs, rows);
+      ab_case<float, 3>(s, 38, reps, block, only, isa, libs, rows);
+      ab_case<float, 2>(s, 234, reps, block, only, isa, libs, rows);
     }
   std::ostringstream o;
   o << "A/B (bench_transfers --ab, " << reps << " reps, alternating, "
