@@ -8,9 +8,9 @@ use ampm_core::lane::Isa;
 use ampm_core::particle::implicit::slot_len;
 use ampm_core::particle::transfer::force::{self, ForceView};
 use ampm_core::particle::update::{elastic_energy, Stiffness};
-use ampm_core::particle::{Definiteness, Grid, Kernel, Material, Particle, Stencil};
+use ampm_core::particle::{Definiteness, Dilation, Grid, Kernel, Material, Particle, Stencil};
 use ampm_core::polar::{DefaultSvd, SvdMethod};
-use ampm_core::{hessian::HessianDim, Error, Mat, Matrix};
+use ampm_core::{hessian::HessianDim, Error, Mat, Matrix, Real};
 use ampm_tools::workload::HaarRotation;
 use rand::{Rng, SeedableRng};
 use rand_pcg::Pcg64;
@@ -444,4 +444,113 @@ fn apply_batch_matches_reference_3d_f64() {
 #[test]
 fn apply_batch_matches_reference_2d_f64() {
     apply_batch_matches_reference::<f64, 2>();
+}
+
+/// Particle `i` of `s` as arrays of one particle (every field as stored, the phase code too).
+fn one_particle<T: Real, const D: usize>(s: &Store<T>, i: usize) -> Store<T> {
+    let rec = |a: &[T], k: usize| a[k * i..k * (i + 1)].to_vec();
+    Store {
+        x: rec(&s.x, D),
+        v: rec(&s.v, D),
+        affine: rec(&s.affine, D * D),
+        f_e: rec(&s.f_e, D * D),
+        f_p: rec(&s.f_p, D * D),
+        mass: rec(&s.mass, 1),
+        volume0: rec(&s.volume0, 1),
+        temperature: rec(&s.temperature, 1),
+        latent: rec(&s.latent, 1),
+        phase: vec![s.phase[i]],
+    }
+}
+
+/// `prepare` of a batch gives every particle the slot (bit for bit) or the error of the same
+/// particle prepared on its own, and the batch reports the first error. Among 70 particles: a NaN
+/// entry of `F_E` (3), `det F_P < 0` (20), `V⁰ = 0` (37), an invalid phase code (42), an `F_E`
+/// whose dilational factor `α` overflows (50; with the explicit dilation), each in a group of eight
+/// otherwise valid particles, then groups of valid ones and a partial group (`f32` prepares the
+/// valid groups of eight on lanes, the others one by one; a single particle always takes the scalar
+/// pass).
+fn prepare_matches_one_by_one<T: BatchReal, const D: usize>()
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+    Mat<f64, D>: Matrix<Scalar = f64, Vector = [f64; D]> + HaarRotation,
+{
+    let (cells, hf, n, sl) = (12, 0.05, 70, slot_len(D));
+    // `J = s^d` is finite, `α = λ J (2J − 1)` is not.
+    let s = T::from_f64(if size_of::<T>() == 4 { 1.0e12 } else { 1.0e100 });
+    for (name, base) in materials::<T>() {
+        for hessian in [Definiteness::Exact, Definiteness::Projected] {
+            let mat = Material { hessian, ..base };
+            let mut rng = Pcg64::seed_from_u64(31);
+            let ps = particles::<T, D>(&mut rng, n, hf, cells, &mat);
+            let mut store = Store::from(&ps);
+            store.f_e[D * D * 3 + 1] = T::from_f64(f64::NAN);
+            for r in 0..D {
+                store.f_p[D * D * 20 + r] = -store.f_p[D * D * 20 + r];
+            }
+            store.volume0[37] = T::ZERO;
+            store.phase[42] = 7;
+            for j in 0..D {
+                for r in 0..D {
+                    store.f_e[D * D * 50 + D * j + r] = if j == r { s } else { T::ZERO };
+                }
+            }
+            for isa in isas() {
+                let mut slots = vec![T::ZERO; n * sl];
+                // SAFETY: n particles, n slots.
+                let st = unsafe {
+                    force::prepare::<T, D>(isa, &mat, n, &store.raw(), slots.as_mut_ptr())
+                };
+                let mut first = (n, None);
+                for i in 0..n {
+                    let mut one = one_particle::<T, D>(&store, i);
+                    let mut slot = vec![T::ZERO; sl];
+                    // SAFETY: one particle, one slot.
+                    let e = unsafe {
+                        force::prepare::<T, D>(isa, &mat, 1, &one.raw(), slot.as_mut_ptr())
+                    }
+                    .error;
+                    let bad = [3, 20, 37, 42].contains(&i)
+                        || (i == 50 && mat.dilation == Dilation::Explicit);
+                    assert_eq!(e.is_some(), bad, "{name} {hessian:?} {isa:?}: particle {i}");
+                    if e.is_some() && first.1.is_none() {
+                        first = (i, e);
+                    }
+                    let got: Vec<u64> = slots[i * sl..(i + 1) * sl]
+                        .iter()
+                        .map(|x| x.to_f64().to_bits())
+                        .collect();
+                    let want: Vec<u64> = slot.iter().map(|x| x.to_f64().to_bits()).collect();
+                    // A failed slot holds tag 0 only; the rest is as the caller left it.
+                    let k = if bad { 1 } else { sl };
+                    assert_eq!(
+                        got[..k],
+                        want[..k],
+                        "{name} {hessian:?} {isa:?}: particle {i}"
+                    );
+                }
+                assert_eq!(
+                    (st.first_failed, st.error),
+                    first,
+                    "{name} {hessian:?} {isa:?}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn prepare_matches_one_by_one_3d_f32() {
+    prepare_matches_one_by_one::<f32, 3>();
+}
+
+#[test]
+fn prepare_matches_one_by_one_2d_f32() {
+    prepare_matches_one_by_one::<f32, 2>();
+}
+
+#[test]
+fn prepare_matches_one_by_one_3d_f64() {
+    prepare_matches_one_by_one::<f64, 3>();
 }

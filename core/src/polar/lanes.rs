@@ -65,11 +65,19 @@ pub fn default_svd<V: Lane, const D: usize>(g: &LMat<V, D>) -> LSvd<V, D> {
 }
 
 /// `m` as a matrix of size `B` (called where `A = B`: the generic dimension as the concrete
-/// one of a decomposition, and back).
+/// one of a decomposition, and back). Loops, not `array::from_fn`: its closures are not
+/// compiled with the caller's target features, and the copy of the vectors became a call to
+/// `memcpy` (seen in a profile of the batch calls).
 #[inline(always)]
 fn resized<V: Copy, const A: usize, const B: usize>(m: &[[V; A]; A]) -> [[V; B]; B] {
     debug_assert_eq!(A, B);
-    core::array::from_fn(|j| core::array::from_fn(|i| m[j][i]))
+    let mut r = [[m[0][0]; B]; B];
+    for (rj, mj) in r.iter_mut().zip(m) {
+        for (x, y) in rj.iter_mut().zip(mj) {
+            *x = *y;
+        }
+    }
+    r
 }
 
 impl<V: Lane, const A: usize> LSvd<V, A> {
@@ -77,9 +85,13 @@ impl<V: Lane, const A: usize> LSvd<V, A> {
     #[inline(always)]
     fn resized<const B: usize>(&self) -> LSvd<V, B> {
         debug_assert_eq!(A, B);
+        let mut sigma = [self.sigma[0]; B];
+        for (x, y) in sigma.iter_mut().zip(&self.sigma) {
+            *x = *y;
+        }
         LSvd {
             u: resized(&self.u),
-            sigma: core::array::from_fn(|i| self.sigma[i]),
+            sigma,
             v: resized(&self.v),
         }
     }

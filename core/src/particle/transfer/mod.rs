@@ -29,6 +29,7 @@
 //! or colours blocks so that concurrently running blocks are three (quadratic) or four (cubic)
 //! cells apart. No atomics are used.
 
+mod deformation_lanes;
 mod field_sums;
 pub mod force;
 pub mod g2p;

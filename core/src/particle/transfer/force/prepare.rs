@@ -1,13 +1,14 @@
 //! [`prepare()`]: the per-particle data of the force differential, once per Newton step.
 
 use crate::error::{Error, Result};
-use crate::kernel::batch::{dispatch, BatchReal, LaneOp, WIDE_LANES};
+use crate::kernel::batch::{dispatch, BatchReal, LaneOp, ScalarRow, WIDE_LANES};
 use crate::kernel::chunk::{check_bits, kernel_lane_error};
 use crate::kernel::{evaluate, flagged, Dim, LaneDim};
 use crate::lane::lmat::LMat;
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::implicit::{blocks, entries, slot_len, tag};
+use crate::particle::transfer::deformation_lanes::deformation_lanes;
 use crate::particle::transfer::{BatchStatus, Checked, FirstFailure, Particles, Reads};
 use crate::particle::update::check_particle;
 use crate::particle::{Definiteness, Dilation, Material};
@@ -88,6 +89,47 @@ where
         }
         Ok((p.f_e, [m.mu, alpha, beta, -p.volume0]))
     }
+
+    /// [`Self::pre`] of particles `start..start + R::LANES` on lanes, into lanes `l0..` of
+    /// `fbuf` (`F_E`, entry `i + d·j`) and `sbuf` (`μ`, `α`, `β`, `−V⁰`), with the same
+    /// operations and bits ([`deformation_lanes`]); returns whether every particle passed
+    /// (else the lanes hold nothing meant to be read, and the caller runs `pre` on each).
+    ///
+    /// # Safety
+    /// As [`Self::pre`], for each of the particles.
+    #[inline(always)]
+    unsafe fn pre_lanes<R: Lane<Scalar = T>>(
+        &self,
+        start: usize,
+        l0: usize,
+        fbuf: &mut [[T; WIDE_LANES]; 9],
+        sbuf: &mut [[T; WIDE_LANES]; 4],
+    ) -> bool {
+        let Some(d) = deformation_lanes::<T, R, D>(self.ps, self.material, &self.checked, start)
+        else {
+            return false;
+        };
+        let zero = R::splat(T::ZERO);
+        let (alpha, beta) = match self.material.dilation {
+            Dilation::Explicit => {
+                let (j, one) = (d.j_e, R::splat(T::ONE));
+                let lj = j / d.inv_lambda;
+                (lj * (j + j - one), -(lj * (j - one)))
+            }
+            Dilation::PressureSolve => (zero, zero),
+        };
+        if !R::all(d.ok & alpha.is_finite() & beta.is_finite()) {
+            return false;
+        }
+        let lanes = l0..l0 + R::LANES;
+        for (c, x) in d.fe.iter().enumerate().take(D * D) {
+            x.store(&mut fbuf[c][lanes.clone()]);
+        }
+        for (row, x) in sbuf.iter_mut().zip([d.mu, alpha, beta, -d.vol]) {
+            x.store(&mut row[lanes.clone()]);
+        }
+        true
+    }
 }
 
 impl<T: BatchReal, const D: usize> LaneOp<T> for PrepareOp<'_, T, D>
@@ -98,13 +140,27 @@ where
     const AVX512_VL: bool = true;
 
     #[inline(always)]
-    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
-        // Chunks of twice the kernel lanes: the decomposition's rotations are latency-bound.
-        self.run::<V::Wide>()
+    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // `dispatch` calls `run_rows`; this is its scalar-row form.
+        self.run_rows::<V, ScalarRow<T>>()
     }
 
     #[inline(always)]
-    fn run<V: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+    fn run_rows<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
+        // Chunks of twice the kernel lanes: the decomposition's rotations are latency-bound.
+        self.run_chunks::<V::Wide, R>()
+    }
+}
+
+impl<T: BatchReal, const D: usize> PrepareOp<'_, T, D>
+where
+    Dim<D>: LaneDim<D>,
+    Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
+{
+    /// The particle loop on chunks of `V`: each particle's [`Self::pre`] (on the lanes of `R`,
+    /// eight particles at once, in `f32`), the kernels on `V`, the slots.
+    #[inline(always)]
+    fn run_chunks<V: Lane<Scalar = T>, R: Lane<Scalar = T>>(&mut self) -> BatchStatus {
         let lanes = V::LANES;
         let sl = slot_len(D);
         let psd = self.material.hessian == Definiteness::Projected;
@@ -114,7 +170,23 @@ where
             let mut fbuf = [[T::ZERO; WIDE_LANES]; 9];
             let mut sbuf = [[T::ZERO; WIDE_LANES]; 4];
             let mut err: [Option<Error>; WIDE_LANES] = [None; WIDE_LANES];
+            // Eight particles at once where they pass on lanes (`f32`, whose eight-lane type
+            // transposes records in registers), else each on its own.
+            let mut from_lanes = 0u64;
+            if size_of::<T>() == 4 {
+                let mut g = 0;
+                while g + R::LANES <= len {
+                    // SAFETY: `prepare`'s contract.
+                    if unsafe { self.pre_lanes::<R>(start + g, g, &mut fbuf, &mut sbuf) } {
+                        from_lanes |= ((1u64 << R::LANES) - 1) << g;
+                    }
+                    g += R::LANES;
+                }
+            }
             for l in 0..lanes {
+                if from_lanes >> l & 1 == 1 {
+                    continue;
+                }
                 let pre = if l < len {
                     // SAFETY: `prepare`'s contract.
                     unsafe { self.pre(start + l) }

@@ -6,7 +6,9 @@
 //! The lanes make the same operations as the scalar pass (separate multiplications and
 //! additions, no fused multiply-add; the determinants of [`crate::mat::Mat`]; the dilational
 //! Kirchhoff stress of [`crate::particle::dilation::kirchhoff`]), so every particle gets the
-//! bits of the scalar pass. If any of the eight particles fails a check of the scalar pass
+//! bits of the scalar pass. The phases, `F_E`, `F_P`, `V⁰` and the moduli come from the pass
+//! that the force differential's prepare shares ([`super::super::deformation_lanes`]). If any
+//! of the eight particles fails a check of the scalar pass
 //! (phase code and material, the checks of [`crate::particle::update::check_particle`], the
 //! temperature with heat on, `1/λ` for the explicit dilation), nothing is kept and the caller
 //! runs the scalar pass on the eight, which gives each its exact error. A factor that overflows
@@ -16,13 +18,13 @@
 use super::{momentum0, P2gOp, Ready};
 use crate::error::{Error, Result};
 use crate::kernel::batch::BatchReal;
-use crate::lane::lmat::{self, LMat};
+use crate::lane::lmat::LMat;
 use crate::lane::Lane;
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::Stencil;
+use crate::particle::transfer::deformation_lanes::{deformation_lanes, pick};
 use crate::particle::transfer::nodes::taint;
-use crate::particle::transfer::rd;
-use crate::particle::{Dilation, Phase};
+use crate::particle::Dilation;
 use crate::scalar::Real;
 
 /// The transposed per-particle data of a chunk of at most `L` particles (entry `[c][l]`:
@@ -129,75 +131,23 @@ where
         let (ps, m) = (self.ps, self.material);
         let n = R::LANES;
         let zero = R::splat(T::ZERO);
-        // Phases (solid when `phase` is null) and the material's validity for each.
-        let mut liq = [T::ZERO; L];
-        let (mut solids, mut liquids) = (ps.phase.is_null(), false);
-        if !ps.phase.is_null() {
-            for (l, f) in liq.iter_mut().enumerate().take(n) {
-                match Phase::from_code(rd(ps.phase as *const u8, start + l)).ok()? {
-                    Phase::Solid => solids = true,
-                    Phase::Liquid => {
-                        liquids = true;
-                        *f = T::ONE;
-                    }
-                }
-            }
-        }
-        if (solids && self.checked.for_phase(Phase::Solid).is_err())
-            || (liquids && self.checked.for_phase(Phase::Liquid).is_err())
-        {
-            return None;
-        }
-        let liq_flags = liq;
-        let liq = zero.lt(R::load(&liq_flags[..n]));
+        let d = deformation_lanes::<T, R, D>(ps, m, &self.checked, start)?;
 
-        // The particle, as `check_particle` checks it.
+        // The rest of the particle, as `check_particle` checks it.
         let mut x = [zero; D];
         let mut v = [zero; D];
         let mut a = [zero; 9];
-        let mut fe = [zero; 9];
-        let mut fp = [zero; 9];
         R::load_records(ps.x.add(D * start), D, &mut x);
         R::load_records(ps.v.add(D * start), D, &mut v);
         R::load_records(ps.affine.add(D * D * start), D * D, &mut a[..D * D]);
-        R::load_records(ps.f_e.add(D * D * start), D * D, &mut fe[..D * D]);
-        R::load_records(ps.f_p.add(D * D * start), D * D, &mut fp[..D * D]);
         let mass: R = load(ps.mass, start);
-        let vol: R = load(ps.volume0, start);
-        let mut ok = mass.is_finite() & vol.is_finite();
+        let mut ok = d.ok & mass.is_finite() & zero.lt(mass);
         for c in x.iter().chain(&v) {
             ok = ok & c.is_finite();
         }
-        for c in 0..D * D {
-            ok = ok & a[c].is_finite() & fe[c].is_finite() & fp[c].is_finite();
+        for c in a.iter().take(D * D) {
+            ok = ok & c.is_finite();
         }
-        ok = ok & zero.lt(mass) & zero.lt(vol);
-        let (j_e, j_p) = (
-            lmat::det(&lmat_of::<R, D>(&fe)),
-            lmat::det(&lmat_of::<R, D>(&fp)),
-        );
-        ok = ok & j_e.is_finite() & j_p.is_finite() & zero.lt(j_e) & zero.lt(j_p);
-        let (mu, inv_lambda) = if matches!(&m.plasticity, Some(s) if s.hardening != T::ZERO) {
-            // Hardened moduli at each lane's `J_P` (`Material::moduli`, one scalar call per
-            // lane); where they do not exist the scalar pass reports it.
-            let mut jp = [T::ZERO; L];
-            j_p.store(&mut jp[..n]);
-            let (mut mus, mut ils) = ([T::ZERO; L], [T::ZERO; L]);
-            for l in 0..n {
-                let phase = match liq_flags[l] == T::ZERO {
-                    true => Phase::Solid,
-                    false => Phase::Liquid,
-                };
-                let md = m.moduli(phase, jp[l]).ok()?;
-                (mus[l], ils[l]) = (md.mu, md.inv_lambda);
-            }
-            (R::load(&mus[..n]), R::load(&ils[..n]))
-        } else {
-            (
-                pick::<T, R>(liq, m.solid.mu, m.liquid.mu),
-                pick::<T, R>(liq, m.solid.inv_lambda, m.liquid.inv_lambda),
-            )
-        };
         let temp = if m.heat.is_some() {
             let t: R = load(ps.temperature, start);
             ok = ok & t.is_finite();
@@ -208,7 +158,7 @@ where
         // `dilation::kirchhoff`'s own checks: `1/λ` finite and positive.
         let explicit = m.dilation == Dilation::Explicit;
         if explicit {
-            ok = ok & inv_lambda.is_finite() & zero.lt(inv_lambda);
+            ok = ok & d.inv_lambda.is_finite() & zero.lt(d.inv_lambda);
         }
         if !R::all(ok) {
             return None;
@@ -217,7 +167,7 @@ where
         // The factors of `ready` that do not depend on the stress.
         let one = R::splat(T::ONE);
         let k = if explicit {
-            (j_e - one) * j_e / inv_lambda
+            (d.j_e - one) * d.j_e / d.inv_lambda
         } else {
             zero
         };
@@ -227,31 +177,31 @@ where
             let y = a[c] * mh;
             fin = fin & y.is_finite();
             put(&mut b.mch[c], l0, y);
-            put(&mut b.f[c], l0, fe[c]);
+            put(&mut b.f[c], l0, d.fe[c]);
         }
         for r in 0..D {
             put(&mut b.mv[r], l0, mass * v[r]);
         }
         if m.heat.is_some() {
-            let mc = mass * pick::<T, R>(liq, m.solid.heat_capacity, m.liquid.heat_capacity);
+            let mc = mass * pick::<T, R>(d.liq, m.solid.heat_capacity, m.liquid.heat_capacity);
             let h = [
                 mc,
                 mc * temp,
-                mass * pick::<T, R>(liq, m.solid.conductivity, m.liquid.conductivity),
+                mass * pick::<T, R>(d.liq, m.solid.conductivity, m.liquid.conductivity),
             ];
             for (c, y) in h.iter().enumerate() {
                 fin = fin & y.is_finite();
                 put(&mut b.heat[c], l0, *y);
             }
         }
-        put(&mut b.mu, l0, mu);
+        put(&mut b.mu, l0, d.mu);
         put(&mut b.k, l0, k);
-        put(&mut b.nvol, l0, -vol);
+        put(&mut b.nvol, l0, -d.vol);
         put(&mut b.mass, l0, mass);
         let all = (1u64 << n) - 1;
         b.finite = b.finite & !(all << l0) | R::mask_bits(fin) << l0;
         R::store_records(xs.as_mut_ptr().add(l0) as *mut T, D, &x);
-        Some(R::any(zero.lt(mu)))
+        Some(R::any(zero.lt(d.mu)))
     }
 
     /// The node loop inputs of lane `l` of `b` (its pass ran on lanes; `fm` and its check set
@@ -321,23 +271,4 @@ pub(super) fn fm_lanes<T: Real, V: Lane<Scalar = T>, const D: usize, const L: us
         }
     }
     b.finite &= V::mask_bits(fin);
-}
-
-/// `s` on the lanes of `liq` false, `l` on the others (a free function, not a closure: a
-/// closure is not compiled with the caller's target features).
-#[inline(always)]
-fn pick<T: Real, R: Lane<Scalar = T>>(liq: R::Mask, s: T, l: T) -> R {
-    R::select(liq, R::splat(l), R::splat(s))
-}
-
-/// The `D × D` lane matrix of column-major entries `e`.
-#[inline(always)]
-fn lmat_of<R: Lane, const D: usize>(e: &[R; 9]) -> LMat<R, D> {
-    let mut m = lmat::zero::<R, D>();
-    for j in 0..D {
-        for i in 0..D {
-            m[j][i] = e[i + D * j];
-        }
-    }
-    m
 }
