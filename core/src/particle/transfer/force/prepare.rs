@@ -8,10 +8,11 @@ use crate::lane::lmat::LMat;
 use crate::lane::{Isa, Lane};
 use crate::mat::{Mat, Matrix};
 use crate::particle::implicit::{blocks, entries, slot_len, tag};
-use crate::particle::transfer::deformation_lanes::deformation_lanes;
+use crate::particle::transfer::deformation_lanes::{deformation_lanes, lanes_ok};
 use crate::particle::transfer::{BatchStatus, Checked, FirstFailure, Particles, Reads};
 use crate::particle::update::check_particle;
 use crate::particle::{Definiteness, Dilation, Material};
+use crate::scalar::Real;
 use core::ptr;
 
 /// Prepares the force differential of `n` particles into `slots` (`n·`[`slot_len`]`(d)`
@@ -77,13 +78,7 @@ where
         self.checked.for_phase(p.phase)?;
         let (j, j_p) = check_particle(&p)?;
         let m = self.material.moduli(p.phase, j_p)?;
-        let (alpha, beta) = match self.material.dilation {
-            Dilation::Explicit => {
-                let lj = j / m.inv_lambda;
-                (lj * (j + j - T::ONE), -(lj * (j - T::ONE)))
-            }
-            Dilation::PressureSolve => (T::ZERO, T::ZERO),
-        };
+        let (alpha, beta) = dilation_factors(self.material.dilation, j, m.inv_lambda);
         if !(alpha.is_finite() && beta.is_finite()) {
             return Err(Error::Overflow);
         }
@@ -109,15 +104,7 @@ where
         else {
             return false;
         };
-        let zero = R::splat(T::ZERO);
-        let (alpha, beta) = match self.material.dilation {
-            Dilation::Explicit => {
-                let (j, one) = (d.j_e, R::splat(T::ONE));
-                let lj = j / d.inv_lambda;
-                (lj * (j + j - one), -(lj * (j - one)))
-            }
-            Dilation::PressureSolve => (zero, zero),
-        };
+        let (alpha, beta) = dilation_factors(self.material.dilation, d.j_e, d.inv_lambda);
         if !R::all(d.ok & alpha.is_finite() & beta.is_finite()) {
             return false;
         }
@@ -173,7 +160,7 @@ where
             // Eight particles at once where they pass on lanes (`f32`, whose eight-lane type
             // transposes records in registers), else each on its own.
             let mut from_lanes = 0u64;
-            if size_of::<T>() == 4 {
+            if lanes_ok::<T>() {
                 let mut g = 0;
                 while g + R::LANES <= len {
                     // SAFETY: `prepare`'s contract.
@@ -269,5 +256,20 @@ where
             start += len;
         }
         self.first.status()
+    }
+}
+
+/// The dilational factors `(α, β)` of the force differential at `J = J_E` (the explicit
+/// dilation: `λJ(2J − 1)` and `−λJ(J − 1)`, formed as `(J/(1/λ))·…`; none with the pressure
+/// solve), for one particle or a lane of them: one formula, so both passes give the same bits.
+#[inline(always)]
+fn dilation_factors<V: Lane>(dilation: Dilation, j: V, inv_lambda: V) -> (V, V) {
+    let (zero, one) = (V::splat(V::Scalar::ZERO), V::splat(V::Scalar::ONE));
+    match dilation {
+        Dilation::Explicit => {
+            let lj = j / inv_lambda;
+            (lj * (j + j - one), -(lj * (j - one)))
+        }
+        Dilation::PressureSolve => (zero, zero),
     }
 }

@@ -1,7 +1,7 @@
 //! P2G's per-particle pass on lanes: the reads, input checks and moduli of
 //! [`P2gOp::pre_into`] and the per-particle factors of [`P2gOp::ready`] for eight consecutive
 //! particles at once (the lanes of a tile row `R`), transposed into a [`ChunkBufs`]; in `f32`
-//! (see [`P2gOp::lanes_ok`]).
+//! (see [`lanes_ok`](crate::particle::transfer::deformation_lanes::lanes_ok)).
 //!
 //! The lanes make the same operations as the scalar pass (separate multiplications and
 //! additions, no fused multiply-add; the determinants of [`crate::mat::Mat`]; the dilational
@@ -105,15 +105,6 @@ impl<T: BatchReal, const D: usize> P2gOp<'_, T, D>
 where
     Mat<T, D>: Matrix<Scalar = T, Vector = [T; D]>,
 {
-    /// Whether this call's particles take the pass on lanes: in `f32` (whose eight-lane type
-    /// loads records by in-register transposes; the `f64` row types gather each component,
-    /// and on AMD Zen 4 that made 3D `f64` P2G 20–40 ns per particle slower than the scalar
-    /// pass).
-    #[inline(always)]
-    pub(super) fn lanes_ok(&self) -> bool {
-        core::mem::size_of::<T>() == 4
-    }
-
     /// The pass of particles `start..start + R::LANES` into lanes `l0..` of `b`, and their
     /// positions into `xs[l0..]`; returns whether every particle passed (else nothing is
     /// meant to be read from those lanes). Also returns whether any lane has `μ > 0`.

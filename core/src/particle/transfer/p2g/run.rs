@@ -13,6 +13,7 @@ use crate::lane::lmat::{mul_nt, LMat};
 use crate::lane::{Lane, Pair, X2};
 use crate::mat::{Mat, Matrix};
 use crate::particle::stencil::Stencil;
+use crate::particle::transfer::deformation_lanes::lanes_ok;
 use crate::particle::transfer::nodes::{
     add, node_offsets, nodes, rel_base, restore, table, with_nodes,
 };
@@ -455,7 +456,7 @@ where
         // The chunk's per-particle data on lanes (see `p2g/lanes.rs`); bit `l` of `fast` when
         // lane `l`'s pass ran on lanes.
         let mut b = ChunkBufs::<T, L>::new();
-        let on_lanes = self.lanes_ok();
+        let on_lanes = lanes_ok::<T>();
         let explicit = self.material.dilation == Dilation::Explicit;
         // The scalar passes of the other lanes, built in place (see `pre_into`); `live[l]`
         // when lane `l`'s succeeded.
